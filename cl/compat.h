@@ -1,0 +1,158 @@
+// Compatibility layer: lets the math headers in cl/ compile both as OpenCL C 1.2 (in the kernels)
+// and as C++20 (in the host reference and the tests), so the two cannot drift apart.
+// Only what the shared headers use is defined here.
+#ifndef CANOPY_CL_COMPAT_H
+#define CANOPY_CL_COMPAT_H
+
+#ifdef __OPENCL_C_VERSION__
+// ---------------------------------------------------------------- OpenCL C
+#define CANOPY_DEVICE 1
+#define INLINE static inline
+#define GLOBAL __global
+#define CONSTANT __constant
+#define make_float2(a, b) ((float2)((a), (b)))
+#define make_float3(a, b, c) ((float3)((a), (b), (c)))
+#define make_float4(a, b, c, d) ((float4)((a), (b), (c), (d)))
+#define make_int4(a, b, c, d) ((int4)((a), (b), (c), (d)))
+#define xyz_of(v) ((v).xyz)
+#define FLT_INF INFINITY
+#pragma OPENCL FP_CONTRACT OFF
+
+INLINE float4 f4_from3(float3 v, float w) { return (float4)(v, w); }
+INLINE float f4_get(float4 v, int i) {
+  return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w));
+}
+INLINE int i4_get(int4 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w)); }
+INLINE bool is_finite_f(float x) { return isfinite(x); }
+INLINE uint float_as_uint_(float x) { return as_uint(x); }
+INLINE float uint_as_float_(uint x) { return as_float(x); }
+
+#else
+// ---------------------------------------------------------------- C++
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+#define INLINE inline
+#define GLOBAL
+#define CONSTANT
+#define FLT_INF (std::numeric_limits<float>::infinity())
+
+typedef unsigned int uint;
+typedef unsigned long ulong_t;
+
+struct float2 {
+  float x, y;
+};
+struct float3 {
+  float x, y, z;
+};
+struct alignas(16) float4 {
+  float x, y, z, w;
+};
+struct alignas(16) int4 {
+  int x, y, z, w;
+};
+static_assert(sizeof(float4) == 16 && sizeof(int4) == 16);
+
+INLINE float2 make_float2(float a, float b) { return {a, b}; }
+INLINE float3 make_float3(float a, float b, float c) { return {a, b, c}; }
+INLINE float4 make_float4(float a, float b, float c, float d) { return {a, b, c, d}; }
+INLINE int4 make_int4(int a, int b, int c, int d) { return {a, b, c, d}; }
+INLINE float3 xyz_of(float4 v) { return {v.x, v.y, v.z}; }
+INLINE float4 f4_from3(float3 v, float w) { return {v.x, v.y, v.z, w}; }
+INLINE float f4_get(float4 v, int i) {
+  return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w));
+}
+INLINE int i4_get(int4 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w)); }
+INLINE bool is_finite_f(float x) { return std::isfinite(x); }
+INLINE uint float_as_uint_(float x) {
+  uint u;
+  std::memcpy(&u, &x, 4);
+  return u;
+}
+INLINE float uint_as_float_(uint x) {
+  float f;
+  std::memcpy(&f, &x, 4);
+  return f;
+}
+
+// float3
+INLINE float3 operator+(float3 a, float3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+INLINE float3 operator-(float3 a, float3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+INLINE float3 operator*(float3 a, float3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+INLINE float3 operator/(float3 a, float3 b) { return {a.x / b.x, a.y / b.y, a.z / b.z}; }
+INLINE float3 operator*(float3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+INLINE float3 operator*(float s, float3 a) { return {a.x * s, a.y * s, a.z * s}; }
+INLINE float3 operator/(float3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
+INLINE float3 operator-(float3 a) { return {-a.x, -a.y, -a.z}; }
+INLINE float3& operator+=(float3& a, float3 b) { return a = a + b; }
+INLINE float3& operator*=(float3& a, float3 b) { return a = a * b; }
+INLINE float3& operator*=(float3& a, float s) { return a = a * s; }
+INLINE float dot(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+INLINE float3 cross(float3 a, float3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+INLINE float length(float3 a) { return std::sqrt(dot(a, a)); }
+INLINE float3 normalize(float3 a) { return a * (1.0f / length(a)); }
+INLINE float3 fmin(float3 a, float3 b) {
+  return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z)};
+}
+INLINE float3 fmax(float3 a, float3 b) {
+  return {std::fmax(a.x, b.x), std::fmax(a.y, b.y), std::fmax(a.z, b.z)};
+}
+INLINE float3 fabs(float3 a) { return {std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)}; }
+
+// float4 (the 4-wide lanes of the light tree)
+INLINE float4 operator+(float4 a, float4 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w};
+}
+INLINE float4 operator-(float4 a, float4 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z, a.w - b.w};
+}
+INLINE float4 operator*(float4 a, float4 b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z, a.w * b.w};
+}
+INLINE float4 operator/(float4 a, float4 b) {
+  return {a.x / b.x, a.y / b.y, a.z / b.z, a.w / b.w};
+}
+INLINE float4 operator*(float4 a, float s) { return {a.x * s, a.y * s, a.z * s, a.w * s}; }
+INLINE float4 operator*(float s, float4 a) { return {a.x * s, a.y * s, a.z * s, a.w * s}; }
+INLINE float4 fmin(float4 a, float4 b) {
+  return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z), std::fmin(a.w, b.w)};
+}
+INLINE float4 fmax(float4 a, float4 b) {
+  return {std::fmax(a.x, b.x), std::fmax(a.y, b.y), std::fmax(a.z, b.z), std::fmax(a.w, b.w)};
+}
+INLINE float4 sqrt(float4 a) {
+  return {std::sqrt(a.x), std::sqrt(a.y), std::sqrt(a.z), std::sqrt(a.w)};
+}
+
+// scalar built-ins with their OpenCL names
+using std::acos;
+using std::atan2;
+using std::cos;
+using std::fabs;
+using std::floor;
+using std::fmax;
+using std::fmin;
+using std::sin;
+using std::sqrt;
+INLINE float clamp(float x, float lo, float hi) { return std::fmin(std::fmax(x, lo), hi); }
+INLINE float mix(float a, float b, float t) { return a + (b - a) * t; }
+INLINE float3 mix(float3 a, float3 b, float t) { return a + (b - a) * t; }
+#ifndef M_PI_F
+#define M_PI_F 3.14159265358979323846f
+#endif
+#endif // __OPENCL_C_VERSION__
+
+#define CANOPY_PI M_PI_F
+#define CANOPY_INV_PI (1.0f / M_PI_F)
+
+// max component and luminance (Rec. 709), used as the scalar "energy" of RGB emission.
+INLINE float luminance3(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+INLINE float max3(float3 c) { return fmax(c.x, fmax(c.y, c.z)); }
+
+#endif // CANOPY_CL_COMPAT_H

@@ -1,0 +1,27 @@
+// Stage 5: add the wave's path radiance into the film. One work item per pixel, visiting that
+// pixel's paths in increasing order, so the sum is race-free and deterministic even when a wave
+// holds several samples of the same pixel. film_sum.w counts samples; film_sumsq holds the
+// per-channel second moment for variance estimates. A non-finite sample never reaches the film:
+// it is counted in nonfinite[0] and recorded as zero.
+#include "types.h"
+
+__kernel void accumulate(ulong wave_base, int wave_size, int npix,
+                         __global const float4* radiance, __global float4* film_sum,
+                         __global float4* film_sumsq, __global int* nonfinite) {
+  int p = get_global_id(0);
+  if (p >= npix) return;
+  int first = (int)(((ulong)p + (ulong)npix - wave_base % (ulong)npix) % (ulong)npix);
+  float4 sum = film_sum[p];
+  float4 sumsq = film_sumsq[p];
+  for (int i = first; i < wave_size; i += npix) {
+    float3 L = radiance[i].xyz;
+    if (!(isfinite(L.x) && isfinite(L.y) && isfinite(L.z))) {
+      atomic_inc(nonfinite);
+      L = (float3)(0.0f);
+    }
+    sum += (float4)(L, 1.0f);
+    sumsq += (float4)(L * L, 0.0f);
+  }
+  film_sum[p] = sum;
+  film_sumsq[p] = sumsq;
+}

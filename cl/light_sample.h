@@ -1,0 +1,117 @@
+// Sampling a point on one light as seen from a shading point, and the emitted radiance of an
+// area light hit by a ray. Shared by shade_surface and the host reference.
+#ifndef CANOPY_CL_LIGHT_SAMPLE_H
+#define CANOPY_CL_LIGHT_SAMPLE_H
+
+#include "compat.h"
+#include "types.h"
+
+typedef struct LightSample {
+  float3 wi;    // unit direction from the shading point towards the light point
+  float dist;   // distance to the light point
+  float3 Li;    // radiance arriving along wi (delta lights: intensity / dist^2)
+  float pdf;    // solid-angle pdf of wi (1 for delta lights); 0 means "no contribution"
+  int is_delta; // point and spot lights
+} LightSample;
+
+// Smoothstep falloff of a spot light between the falloff start and the cone edge.
+INLINE float spot_falloff(const GLOBAL Light* l, float cos_theta) {
+  float cos_edge = l->e1.w, cos_start = l->e2.w;
+  if (cos_theta >= cos_start) return 1.0f;
+  if (cos_theta <= cos_edge) return 0.0f;
+  float x = (cos_theta - cos_edge) / (cos_start - cos_edge);
+  return x * x * (3.0f - 2.0f * x);
+}
+
+// Whether an area light with normal n emits towards direction w (unit, pointing away from it).
+INLINE int light_emits_towards(const GLOBAL Light* l, float3 w) {
+  if (l->flags & LIGHT_FLAG_TWO_SIDED) return 1;
+  return dot(xyz_of(l->n), w) > 0.0f;
+}
+
+INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float u2) {
+  LightSample s;
+  s.wi = make_float3(0.0f, 0.0f, 1.0f);
+  s.dist = 0.0f;
+  s.Li = make_float3(0.0f, 0.0f, 0.0f);
+  s.pdf = 0.0f;
+  s.is_delta = 0;
+  float3 L = xyz_of(l->emission);
+  if (l->type == LIGHT_POINT || l->type == LIGHT_SPOT) {
+    float3 to = xyz_of(l->p) - P;
+    float d2 = dot(to, to);
+    if (!(d2 > 0.0f)) return s;
+    s.dist = sqrt(d2);
+    s.wi = to / s.dist;
+    float k = 1.0f / d2;
+    if (l->type == LIGHT_SPOT) k *= spot_falloff(l, -dot(s.wi, xyz_of(l->e1)));
+    s.Li = L * k;
+    s.pdf = 1.0f;
+    s.is_delta = 1;
+    return s;
+  }
+  if (l->type == LIGHT_SPHERE) {
+    // Uniform sampling of the cone of directions the sphere subtends (pbrt-v4 §6.2.4).
+    float3 c = xyz_of(l->p);
+    float r = l->p.w;
+    float3 to = c - P;
+    float d2 = dot(to, to);
+    if (!(d2 > r * r)) return s; // inside the sphere: it emits outwards only
+    float d = sqrt(d2);
+    float3 w = to / d;
+    float sin2_max = r * r / d2;
+    float cos_max = sqrt(fmax(0.0f, 1.0f - sin2_max));
+    // 1 - cos_max without cancellation for small spheres.
+    float one_minus_cos_max = sin2_max / (1.0f + cos_max);
+    float one_minus_cos = u1 * one_minus_cos_max;
+    float cos_t = 1.0f - one_minus_cos;
+    float sin2_t = one_minus_cos * (2.0f - one_minus_cos);
+    float sin_t = sqrt(fmax(0.0f, sin2_t));
+    float phi = 2.0f * CANOPY_PI * u2;
+    // Orthonormal basis around w (Duff et al. 2017).
+    float sign = w.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (sign + w.z);
+    float b = w.x * w.y * a;
+    float3 t1 = make_float3(1.0f + sign * w.x * w.x * a, sign * b, -sign * w.x);
+    float3 t2 = make_float3(b, sign + w.y * w.y * a, -w.y);
+    s.wi = normalize(t1 * (sin_t * cos(phi)) + t2 * (sin_t * sin(phi)) + w * cos_t);
+    // Distance to the near intersection along wi.
+    float dc = d * cos_t;
+    s.dist = fmax(0.0f, dc - sqrt(fmax(0.0f, r * r - d2 * sin2_t)));
+    s.Li = L;
+    s.pdf = 1.0f / (2.0f * CANOPY_PI * one_minus_cos_max);
+    return s;
+  }
+  // Quad and triangle: uniform in area, converted to solid angle.
+  float3 q;
+  if (l->type == LIGHT_QUAD) {
+    q = xyz_of(l->p) + xyz_of(l->e1) * u1 + xyz_of(l->e2) * u2;
+  } else {
+    float su = sqrt(u1);
+    q = xyz_of(l->p) + xyz_of(l->e1) * (1.0f - su) + xyz_of(l->e2) * (u2 * su);
+  }
+  float3 to = q - P;
+  float d2 = dot(to, to);
+  if (!(d2 > 0.0f)) return s;
+  s.dist = sqrt(d2);
+  s.wi = to / s.dist;
+  float cos_l = dot(xyz_of(l->n), -s.wi);
+  if (!light_emits_towards(l, -s.wi) || cos_l == 0.0f) return s;
+  s.Li = L;
+  s.pdf = d2 / (fabs(cos_l) * l->n.w);
+  return s;
+}
+
+// Radiance leaving light l towards direction w_out (unit, pointing away from the light), for a
+// ray that hit the light's surface.
+INLINE float3 light_emitted_radiance(const GLOBAL Light* l, float3 surface_normal, float3 w_out) {
+  if (l->type == LIGHT_SPHERE) {
+    return dot(surface_normal, w_out) > 0.0f ? xyz_of(l->emission) : make_float3(0.0f, 0.0f, 0.0f);
+  }
+  if (l->type == LIGHT_QUAD || l->type == LIGHT_TRIANGLE) {
+    return light_emits_towards(l, w_out) ? xyz_of(l->emission) : make_float3(0.0f, 0.0f, 0.0f);
+  }
+  return make_float3(0.0f, 0.0f, 0.0f);
+}
+
+#endif // CANOPY_CL_LIGHT_SAMPLE_H

@@ -1,0 +1,90 @@
+// Data layouts shared by the host and the OpenCL kernels. Every struct here is stored in device
+// buffers, so it uses only 4-byte scalars and 16-byte-aligned float4/int4 members: the layout is
+// the same in OpenCL C and in C++ (checked by static_asserts on the host).
+#ifndef CANOPY_CL_TYPES_H
+#define CANOPY_CL_TYPES_H
+
+#include "compat.h"
+
+// ---------------------------------------------------------------- lights
+#define LIGHT_POINT 0    // isotropic point: radiant intensity I [W/sr]
+#define LIGHT_SPOT 1     // point with a cone: I [W/sr], axis, smooth falloff
+#define LIGHT_SPHERE 2   // spherical area light: radiance L [W/(m^2 sr)], radius r
+#define LIGHT_QUAD 3     // parallelogram area light: radiance L, one- or two-sided
+#define LIGHT_TRIANGLE 4 // triangle area light: radiance L (also every emissive mesh triangle)
+#define LIGHT_TYPE_COUNT 5
+
+#define LIGHT_FLAG_TWO_SIDED 1 // quad/triangle emit on both faces
+#define LIGHT_FLAG_FROM_MESH 2 // triangle is part of a mesh already in the geometry
+
+typedef struct Light {
+  float4 p;   // point/spot/sphere: position (xyz), sphere radius (w). quad: corner. triangle: v0.
+  float4 e1;  // quad: edge 1; triangle: v1 - v0; spot: unit axis (xyz), cos of cone half-angle (w)
+  float4 e2;  // quad: edge 2; triangle: v2 - v0; spot: cos of falloff-start half-angle (w)
+  float4 n;   // quad/triangle: unit normal of the emitting face (xyz), area (w)
+  float4 emission; // rgb: intensity (point/spot) or radiance (area lights)
+  int type;
+  int flags;
+  int prim; // first geometry primitive that shows this light (-1 for point/spot)
+  int pad;
+} Light;
+
+// ---------------------------------------------------------------- materials
+#define MATERIAL_DIFFUSE 0
+
+typedef struct Material {
+  float4 albedo; // rgb reflectance in [0,1]
+  int type;
+  int pad0, pad1, pad2;
+} Material;
+
+// ---------------------------------------------------------------- geometry / BVH
+// A primitive is a triangle or a sphere. Vertices are stored with the primitive so the intersect
+// kernel reads one contiguous record.
+#define PRIM_TRIANGLE 0
+#define PRIM_SPHERE 1
+
+typedef struct Primitive {
+  float4 v0; // triangle: vertex 0 (xyz). sphere: centre (xyz), radius (w).
+  float4 e1; // triangle: v1 - v0. sphere: unused.
+  float4 e2; // triangle: v2 - v0. sphere: unused.
+  int type;
+  int material; // index into materials
+  int light;    // index of the light this primitive shows, or -1
+  int pad;
+} Primitive;
+
+// Binary BVH node in a flat array. Interior: children at `left` and `right`. Leaf: `count` > 0
+// primitives starting at `first` in the primitive-index array.
+typedef struct BvhNode {
+  float4 bmin; // xyz: box min, w: as_float(left or first)
+  float4 bmax; // xyz: box max, w: as_float(right or -count) -- see bvh_node_* accessors
+} BvhNode;
+
+// ---------------------------------------------------------------- camera
+typedef struct CameraParams {
+  float4 origin;
+  float4 lower_left; // world position of the image plane corner at distance 1
+  float4 du;         // image plane step per pixel in x
+  float4 dv;         // image plane step per pixel in y (downwards)
+  int width;
+  int height;
+  int pad0, pad1;
+} CameraParams;
+
+// ---------------------------------------------------------------- wavefront records
+typedef struct Hit {
+  float t;
+  int prim; // -1: miss
+  float u, v;
+} Hit;
+
+// A shadow work item: a ray towards a sampled light point and the contribution it carries if the
+// segment is unoccluded (throughput * BSDF * cos * Le / pdf already applied).
+typedef struct ShadowItem {
+  float4 origin;       // xyz origin, w: tmax
+  float4 dir;          // xyz unit direction, w: path id (as int bits)
+  float4 contribution; // rgb
+} ShadowItem;
+
+#endif // CANOPY_CL_TYPES_H

@@ -1,0 +1,301 @@
+#include "accel/bvh.h"
+
+#include "geometry.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace canopy {
+
+namespace {
+
+constexpr unsigned kMaxDepth = 48; // < BVH_STACK_SIZE (cl/geometry.h)
+
+Primitive make_triangle(float3 a, float3 b, float3 c, int material, int light) {
+  Primitive p{};
+  p.v0 = f4_from3(a, 0.0f);
+  p.e1 = f4_from3(b - a, 0.0f);
+  p.e2 = f4_from3(c - a, 0.0f);
+  p.type = PRIM_TRIANGLE;
+  p.material = material;
+  p.light = light;
+  return p;
+}
+
+void primitive_bounds(const Primitive& p, float3& lo, float3& hi) {
+  float3 v0 = xyz_of(p.v0);
+  if (p.type == PRIM_SPHERE) {
+    float r = p.v0.w;
+    lo = v0 - make_float3(r, r, r);
+    hi = v0 + make_float3(r, r, r);
+    return;
+  }
+  float3 v1 = v0 + xyz_of(p.e1), v2 = v0 + xyz_of(p.e2);
+  lo = fmin(v0, fmin(v1, v2));
+  hi = fmax(v0, fmax(v1, v2));
+}
+
+// Temporary tree produced by Embree's callbacks (allocated in Embree's thread-local arenas).
+struct BuildNode {
+  bool leaf;
+  int count;             // leaf: primitive count
+  RTCBounds bounds[2];   // interior: child bounds
+  BuildNode* children[2];
+  const unsigned* ids;   // leaf: primitive ids
+};
+
+void* create_node(RTCThreadLocalAllocator alloc, unsigned int, void*) {
+  auto* n = static_cast<BuildNode*>(rtcThreadLocalAlloc(alloc, sizeof(BuildNode), 16));
+  *n = BuildNode{};
+  return n;
+}
+
+void set_children(void* node, void** children, unsigned int count, void*) {
+  auto* n = static_cast<BuildNode*>(node);
+  for (unsigned i = 0; i < 2; ++i) n->children[i] = i < count ? static_cast<BuildNode*>(children[i]) : nullptr;
+}
+
+void set_bounds(void* node, const RTCBounds** bounds, unsigned int count, void*) {
+  auto* n = static_cast<BuildNode*>(node);
+  for (unsigned i = 0; i < count && i < 2; ++i) n->bounds[i] = *bounds[i];
+}
+
+void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count, void*) {
+  auto* n = static_cast<BuildNode*>(rtcThreadLocalAlloc(alloc, sizeof(BuildNode), 16));
+  auto* ids = static_cast<unsigned*>(rtcThreadLocalAlloc(alloc, sizeof(unsigned) * count, 16));
+  for (size_t i = 0; i < count; ++i) ids[i] = prims[i].primID;
+  *n = BuildNode{};
+  n->leaf = true;
+  n->count = int(count);
+  n->ids = ids;
+  return n;
+}
+
+BvhNode pack_node(const RTCBounds& b, int a_lane, int b_lane) {
+  BvhNode n;
+  n.bmin = make_float4(b.lower_x, b.lower_y, b.lower_z, uint_as_float_(uint(a_lane)));
+  n.bmax = make_float4(b.upper_x, b.upper_y, b.upper_z, uint_as_float_(uint(b_lane)));
+  return n;
+}
+
+// Depth-first flatten; the node for `src` has already been reserved at index `at`.
+void flatten(const BuildNode* src, const RTCBounds& box, int at, int depth, Bvh& out) {
+  out.depth = std::max(out.depth, depth);
+  if (src->leaf) {
+    int first = int(out.prim_index.size());
+    for (int i = 0; i < src->count; ++i) out.prim_index.push_back(int(src->ids[i]));
+    out.nodes[at] = pack_node(box, first, -src->count);
+    return;
+  }
+  int left = int(out.nodes.size());
+  out.nodes.emplace_back();
+  int right = int(out.nodes.size());
+  out.nodes.emplace_back();
+  out.nodes[at] = pack_node(box, left, right);
+  flatten(src->children[0], src->bounds[0], left, depth + 1, out);
+  flatten(src->children[1], src->bounds[1], right, depth + 1, out);
+}
+
+} // namespace
+
+std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& materials) {
+  std::vector<Primitive> prims;
+  prims.reserve(scene.triangle_count() + scene.lights.size());
+  for (size_t t = 0; t < scene.triangle_count(); ++t) {
+    const float3 a = scene.vertices[scene.indices[3 * t]];
+    const float3 b = scene.vertices[scene.indices[3 * t + 1]];
+    const float3 c = scene.vertices[scene.indices[3 * t + 2]];
+    int light = scene.triangle_light.empty() ? -1 : scene.triangle_light[t];
+    prims.push_back(make_triangle(a, b, c, scene.triangle_material[t], light));
+    if (light >= 0) scene.lights[light].prim = int(t);
+  }
+  // Light shapes are black: they emit, they do not reflect.
+  int black = int(materials.size());
+  Material m{};
+  m.albedo = make_float4(0, 0, 0, 0);
+  m.type = MATERIAL_DIFFUSE;
+  materials.push_back(m);
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    Light& l = scene.lights[i];
+    if (l.flags & LIGHT_FLAG_FROM_MESH) continue;
+    float3 p = xyz_of(l.p), e1 = xyz_of(l.e1), e2 = xyz_of(l.e2);
+    if (l.type == LIGHT_SPHERE) {
+      Primitive s{};
+      s.v0 = l.p;
+      s.type = PRIM_SPHERE;
+      s.material = black;
+      s.light = int(i);
+      l.prim = int(prims.size());
+      prims.push_back(s);
+    } else if (l.type == LIGHT_QUAD) {
+      l.prim = int(prims.size());
+      prims.push_back(make_triangle(p, p + e1, p + e1 + e2, black, int(i)));
+      prims.push_back(make_triangle(p, p + e1 + e2, p + e2, black, int(i)));
+    } else if (l.type == LIGHT_TRIANGLE) {
+      l.prim = int(prims.size());
+      prims.push_back(make_triangle(p, p + e1, p + e2, black, int(i)));
+    } else {
+      l.prim = -1;
+    }
+  }
+  return prims;
+}
+
+Bvh build_bvh(const std::vector<Primitive>& prims) {
+  Bvh out;
+  if (prims.empty()) {
+    // An empty scene: one empty leaf with an inverted box that every ray misses.
+    BvhNode n;
+    float inf = std::numeric_limits<float>::infinity();
+    n.bmin = make_float4(inf, inf, inf, uint_as_float_(0));
+    n.bmax = make_float4(-inf, -inf, -inf, uint_as_float_(uint(-0)));
+    out.nodes.push_back(n);
+    return out;
+  }
+  RTCDevice device = rtcNewDevice(nullptr);
+  if (!device) throw std::runtime_error("rtcNewDevice failed");
+  std::vector<RTCBuildPrimitive> bp(prims.size());
+  RTCBounds root{};
+  root.lower_x = root.lower_y = root.lower_z = std::numeric_limits<float>::infinity();
+  root.upper_x = root.upper_y = root.upper_z = -std::numeric_limits<float>::infinity();
+  for (size_t i = 0; i < prims.size(); ++i) {
+    float3 lo, hi;
+    primitive_bounds(prims[i], lo, hi);
+    bp[i] = RTCBuildPrimitive{lo.x, lo.y, lo.z, 0, hi.x, hi.y, hi.z, unsigned(i)};
+    root.lower_x = std::min(root.lower_x, lo.x);
+    root.lower_y = std::min(root.lower_y, lo.y);
+    root.lower_z = std::min(root.lower_z, lo.z);
+    root.upper_x = std::max(root.upper_x, hi.x);
+    root.upper_y = std::max(root.upper_y, hi.y);
+    root.upper_z = std::max(root.upper_z, hi.z);
+  }
+  RTCBVH bvh = rtcNewBVH(device);
+  RTCBuildArguments args = rtcDefaultBuildArguments();
+  args.byteSize = sizeof(args);
+  args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
+  args.maxBranchingFactor = 2;
+  args.maxDepth = kMaxDepth;
+  args.sahBlockSize = 1;
+  args.minLeafSize = 1;
+  args.maxLeafSize = 4;
+  args.traversalCost = 1.0f;
+  args.intersectionCost = 1.0f;
+  args.bvh = bvh;
+  args.primitives = bp.data();
+  args.primitiveCount = bp.size();
+  args.primitiveArrayCapacity = bp.size();
+  args.createNode = create_node;
+  args.setNodeChildren = set_children;
+  args.setNodeBounds = set_bounds;
+  args.createLeaf = create_leaf;
+  args.splitPrimitive = nullptr;
+  auto* root_node = static_cast<BuildNode*>(rtcBuildBVH(&args));
+  if (!root_node) {
+    rtcReleaseBVH(bvh);
+    rtcReleaseDevice(device);
+    throw std::runtime_error("rtcBuildBVH failed");
+  }
+  out.nodes.reserve(2 * prims.size());
+  out.prim_index.reserve(prims.size());
+  out.nodes.emplace_back();
+  flatten(root_node, root, 0, 0, out);
+  rtcReleaseBVH(bvh);
+  rtcReleaseDevice(device);
+  return out;
+}
+
+SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& materials) {
+  SceneGeometry g;
+  g.prims = build_primitives(scene, materials);
+  g.bvh = build_bvh(g.prims);
+  float3 lo = make_float3(0, 0, 0), hi = lo;
+  bool any = false;
+  auto grow = [&](float3 a, float3 b) {
+    lo = any ? fmin(lo, a) : a;
+    hi = any ? fmax(hi, b) : b;
+    any = true;
+  };
+  for (const Primitive& p : g.prims) {
+    float3 a, b;
+    primitive_bounds(p, a, b);
+    grow(a, b);
+  }
+  for (const Light& l : scene.lights) grow(xyz_of(l.p), xyz_of(l.p));
+  grow(scene.camera.position, scene.camera.position);
+  g.bounds_min = lo;
+  g.bounds_max = hi;
+  float3 ext = hi - lo;
+  float extent = std::max({ext.x, ext.y, ext.z, std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z),
+                           std::fabs(hi.x), std::fabs(hi.y), std::fabs(hi.z)});
+  g.ray_eps = extent > 0.0f ? 1e-5f * extent : 1e-5f;
+  return g;
+}
+
+EmbreeReference::EmbreeReference(const std::vector<Primitive>& triangles) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error("rtcNewDevice failed");
+  scene_ = rtcNewScene(device_);
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        3 * sizeof(float), 3 * triangles.size()));
+  auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size()));
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    const Primitive& p = triangles[i];
+    if (p.type != PRIM_TRIANGLE) throw std::invalid_argument("EmbreeReference: triangles only");
+    float3 a = xyz_of(p.v0), b = a + xyz_of(p.e1), c = a + xyz_of(p.e2);
+    float* dst = v + 9 * i;
+    dst[0] = a.x, dst[1] = a.y, dst[2] = a.z;
+    dst[3] = b.x, dst[4] = b.y, dst[5] = b.z;
+    dst[6] = c.x, dst[7] = c.y, dst[8] = c.z;
+    idx[3 * i] = unsigned(3 * i);
+    idx[3 * i + 1] = unsigned(3 * i + 1);
+    idx[3 * i + 2] = unsigned(3 * i + 2);
+  }
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(scene_, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(scene_);
+  if (RTCError e = rtcGetDeviceError(device_); e != RTC_ERROR_NONE)
+    throw std::runtime_error(fmt::format("Embree error {} building the reference scene", int(e)));
+}
+
+EmbreeReference::~EmbreeReference() {
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+int EmbreeReference::intersect(float3 o, float3 d, float tmin, float tmax, float* t) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh{};
+  rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z;
+  rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+  rh.ray.tnear = tmin;
+  rh.ray.tfar = tmax;
+  rh.ray.mask = ~0u;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene_, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
+  *t = rh.ray.tfar;
+  return int(rh.hit.primID);
+}
+
+bool EmbreeReference::occluded(float3 o, float3 d, float tmin, float tmax) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRay r{};
+  r.org_x = o.x, r.org_y = o.y, r.org_z = o.z;
+  r.dir_x = d.x, r.dir_y = d.y, r.dir_z = d.z;
+  r.tnear = tmin;
+  r.tfar = tmax;
+  r.mask = ~0u;
+  rtcOccluded1(scene_, &ctx, &r);
+  return r.tfar < 0.0f; // Embree sets tfar = -inf on a hit
+}
+
+} // namespace canopy

@@ -1,0 +1,57 @@
+// Geometry acceleration: the primitives of a scene (its triangles plus the shapes of analytic area
+// lights), a binary BVH over them built by Embree's rtcBuildBVH (SAH) and flattened for the
+// intersect kernels, and an Embree RTCScene used as the reference intersector in tests/benchmarks.
+#pragma once
+
+#include "scene/scene.h"
+#include "types.h"
+
+#include <embree3/rtcore.h>
+
+#include <vector>
+
+namespace canopy {
+
+struct Bvh {
+  std::vector<BvhNode> nodes;   // nodes[0] is the root
+  std::vector<int> prim_index;  // leaf slots -> primitive index
+  int depth = 0;                // longest root-to-leaf path (<= BVH_STACK_SIZE)
+};
+
+struct SceneGeometry {
+  std::vector<Primitive> prims;
+  Bvh bvh;
+  float3 bounds_min{0, 0, 0}, bounds_max{0, 0, 0};
+  float ray_eps = 1e-5f; // ray origin offset: 1e-5 x the scene's extent (see cl/shading.h)
+};
+
+// Primitives for every scene triangle and every sphere/quad/triangle light (a quad is two
+// triangles). Sets Light::prim of each light that has a shape (mesh-light triangles point at their
+// own triangle). Analytic light shapes use an extra black material appended to the list.
+std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& materials);
+
+// SAH BVH over `prims`, via rtcBuildBVH; depth limited so the kernels' fixed stack never
+// overflows.
+Bvh build_bvh(const std::vector<Primitive>& prims);
+
+SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& materials);
+
+// Embree's own BVH over the triangle primitives: the reference for the intersect kernels.
+class EmbreeReference {
+public:
+  explicit EmbreeReference(const std::vector<Primitive>& triangles);
+  ~EmbreeReference();
+  EmbreeReference(const EmbreeReference&) = delete;
+  EmbreeReference& operator=(const EmbreeReference&) = delete;
+
+  // Closest hit: returns the primitive index or -1, and its t.
+  int intersect(float3 o, float3 d, float tmin, float tmax, float* t) const;
+  bool occluded(float3 o, float3 d, float tmin, float tmax) const;
+  RTCScene scene() const { return scene_; }
+
+private:
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+};
+
+} // namespace canopy

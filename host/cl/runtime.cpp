@@ -1,0 +1,160 @@
+#include "cl/runtime.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+namespace canopy {
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw ClError(fmt::format("{}: cannot open kernel source", p.string()));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::filesystem::path executable_dir() {
+  char buf[4096];
+  ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+  if (n <= 0) return {};
+  buf[n] = 0;
+  return std::filesystem::path(buf).parent_path();
+}
+
+} // namespace
+
+std::vector<DeviceInfo> list_devices() {
+  std::vector<DeviceInfo> out;
+  std::vector<cl::Platform> platforms;
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error&) {
+    return out; // CL_PLATFORM_NOT_FOUND_KHR: no ICD
+  }
+  for (size_t p = 0; p < platforms.size(); ++p) {
+    std::vector<cl::Device> devices;
+    try {
+      platforms[p].getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+      continue;
+    }
+    for (size_t d = 0; d < devices.size(); ++d) {
+      DeviceInfo info;
+      info.platform_index = int(p);
+      info.device_index = int(d);
+      info.platform_name = platforms[p].getInfo<CL_PLATFORM_NAME>();
+      info.device_name = devices[d].getInfo<CL_DEVICE_NAME>();
+      info.version = devices[d].getInfo<CL_DEVICE_VERSION>();
+      info.type = devices[d].getInfo<CL_DEVICE_TYPE>();
+      info.compute_units = devices[d].getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+      info.global_mem = devices[d].getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+      out.push_back(info);
+    }
+  }
+  return out;
+}
+
+std::filesystem::path kernel_dir() {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("CANOPY_KERNEL_DIR")) {
+    if (fs::exists(fs::path(env) / "types.h")) return env;
+    throw ClError(fmt::format("CANOPY_KERNEL_DIR={}: no kernel sources there", env));
+  }
+  fs::path installed = executable_dir() / ".." / "share" / "canopy" / "cl";
+  if (fs::exists(installed / "types.h")) return fs::canonical(installed);
+  if (fs::exists(fs::path(CANOPY_INSTALL_CL_DIR) / "types.h")) return CANOPY_INSTALL_CL_DIR;
+  if (fs::exists(fs::path(CANOPY_SOURCE_CL_DIR) / "types.h")) return CANOPY_SOURCE_CL_DIR;
+  throw ClError("cannot find the kernel sources (set CANOPY_KERNEL_DIR to the cl/ directory)");
+}
+
+ClRuntime::ClRuntime(const std::string& device_name) {
+  std::vector<DeviceInfo> devices = list_devices();
+  if (devices.empty())
+    throw ClError("no OpenCL device found (is pocl-opencl-icd installed? run scripts/install-deps.sh)");
+  const DeviceInfo* chosen = nullptr;
+  if (!device_name.empty()) {
+    std::string want = lower(device_name);
+    for (const auto& d : devices)
+      if (lower(d.device_name).find(want) != std::string::npos ||
+          lower(d.platform_name).find(want) != std::string::npos) {
+        chosen = &d;
+        break;
+      }
+    if (!chosen) throw ClError(fmt::format("no OpenCL device matches '{}' (see `canopy info`)", device_name));
+  } else {
+    for (const auto& d : devices)
+      if ((d.type & CL_DEVICE_TYPE_CPU) && lower(d.platform_name).find("portable") != std::string::npos) {
+        chosen = &d;
+        break;
+      }
+    if (!chosen)
+      for (const auto& d : devices)
+        if (d.type & CL_DEVICE_TYPE_CPU) {
+          chosen = &d;
+          break;
+        }
+    if (!chosen) chosen = &devices.front();
+  }
+  std::vector<cl::Platform> platforms;
+  cl::Platform::get(&platforms);
+  std::vector<cl::Device> devs;
+  platforms[chosen->platform_index].getDevices(CL_DEVICE_TYPE_ALL, &devs);
+  device_ = devs[chosen->device_index];
+  context_ = cl::Context(device_);
+  queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
+}
+
+std::string ClRuntime::device_name() const { return device_.getInfo<CL_DEVICE_NAME>(); }
+
+cl::Program ClRuntime::build_program(const std::vector<std::string>& files,
+                                     const std::string& options) const {
+  std::filesystem::path dir = kernel_dir();
+  std::string source;
+  for (const auto& f : files) source += read_text(dir / f) + "\n";
+  cl::Program program(context_, source);
+  // PoCL passes the option string to clang verbatim: no quotes, so escape spaces instead.
+  std::string inc;
+  for (char c : dir.string()) inc += c == ' ' ? std::string("\\ ") : std::string(1, c);
+  std::string opts = fmt::format("-I {} -cl-std=CL1.2 {}", inc, options);
+  try {
+    program.build({device_}, opts.c_str());
+  } catch (const cl::Error&) {
+    std::string log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
+    throw ClError(fmt::format("OpenCL program build failed (options: {}):\n{}", opts, log));
+  }
+  return program;
+}
+
+cl::Event enqueue_1d(cl::CommandQueue& q, const cl::Kernel& k, size_t n, size_t local) {
+  cl::Event ev;
+  if (n == 0) return ev;
+  if (local > 0) {
+    size_t global = (n + local - 1) / local * local;
+    q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(local), nullptr, &ev);
+  } else {
+    q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NullRange, nullptr, &ev);
+  }
+  return ev;
+}
+
+double event_seconds(const cl::Event& e) {
+  if (e() == nullptr) return 0.0;
+  cl_ulong start = e.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+  cl_ulong end = e.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+  return double(end - start) * 1e-9;
+}
+
+} // namespace canopy

@@ -1,0 +1,65 @@
+// OpenCL runtime: device selection (PoCL CPU by default), program builds from cl/ with build logs
+// on failure, and an in-order command queue with profiling enabled.
+#pragma once
+
+#include <CL/opencl.hpp>
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace canopy {
+
+class ClError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+struct DeviceInfo {
+  int platform_index;
+  int device_index;
+  std::string platform_name;
+  std::string device_name;
+  std::string version;
+  cl_device_type type;
+  cl_uint compute_units;
+  cl_ulong global_mem;
+};
+
+// Every device of every platform (empty when no ICD is installed).
+std::vector<DeviceInfo> list_devices();
+
+// The directory holding the kernel sources: $CANOPY_KERNEL_DIR if set, else the installed
+// share/canopy/cl next to the binary's prefix, else the source tree's cl/.
+std::filesystem::path kernel_dir();
+
+class ClRuntime {
+public:
+  // `device_name` empty: the first PoCL CPU device (else the first CPU device, else any).
+  // Otherwise the first device whose device or platform name contains it (case-insensitive).
+  explicit ClRuntime(const std::string& device_name = "");
+
+  // Builds a program from the given files (relative to kernel_dir()) with "-I <kernel_dir>" and
+  // `options` appended. Throws ClError holding the build log on failure.
+  cl::Program build_program(const std::vector<std::string>& files,
+                            const std::string& options = "") const;
+
+  const cl::Context& context() const { return context_; }
+  const cl::Device& device() const { return device_; }
+  cl::CommandQueue& queue() { return queue_; }
+  std::string device_name() const;
+
+private:
+  cl::Context context_;
+  cl::Device device_;
+  cl::CommandQueue queue_;
+};
+
+// Launch helper: global size rounded up to a multiple of `local` (0 = let the runtime choose).
+cl::Event enqueue_1d(cl::CommandQueue& q, const cl::Kernel& k, size_t n, size_t local = 0);
+
+// Nanoseconds between a finished event's start and end (profiling).
+double event_seconds(const cl::Event& e);
+
+} // namespace canopy

@@ -1,0 +1,29 @@
+// Image output through OpenImageIO: linear float EXR (with metadata) and sRGB 8-bit PNG.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace canopy {
+
+struct RgbImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb; // row-major, top row first, 3 floats per pixel, linear
+};
+
+// Writes a linear half/float EXR; `metadata` entries become string attributes (e.g.
+// "canopy:sampler"). Throws std::runtime_error naming the file on failure.
+void write_exr(const std::filesystem::path& file, const RgbImage& img,
+               const std::vector<std::pair<std::string, std::string>>& metadata = {});
+
+// Writes an 8-bit PNG with the sRGB transfer curve (values clamped to [0, 1]).
+void write_png(const std::filesystem::path& file, const RgbImage& img);
+
+// Reads any image OpenImageIO understands into linear RGB float (first three channels).
+RgbImage read_image(const std::filesystem::path& file);
+
+float srgb_encode(float linear);
+
+} // namespace canopy

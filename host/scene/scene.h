@@ -1,0 +1,76 @@
+// The in-memory scene: everything the renderer needs, in world space, already validated.
+// Produced by load_scene() (scene_loader.cpp) from the JSON format documented in
+// docs/scene-format.md.
+#pragma once
+
+#include "types.h" // cl/types.h: Light, Material (device layouts)
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace canopy {
+
+// Thrown for any invalid input. what() is the complete one-line message, formatted as
+// "<file>: <json path>: <problem>", e.g. "scene.json: lights[3].radius: must be > 0".
+// The CLI prints it and exits with code 2.
+class SceneError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Camera {
+  float3 position{0, 0, 0};
+  float3 look_at{0, 0, -1};
+  float3 up{0, 1, 0};
+  float fov_y_deg = 45.0f; // vertical field of view, degrees, in (0, 180)
+};
+
+struct FilmSettings {
+  int width = 640;  // pixels, 1 .. 16384
+  int height = 480; // pixels, 1 .. 16384
+};
+
+struct IntegratorSettings {
+  int spp = 16;                          // samples per pixel, >= 1
+  int max_depth = 1;                     // path vertices after the camera hit: 1 = direct light only
+  std::string light_sampler = "uniform"; // uniform | power | tree | tree-split | exhaustive
+  float split_threshold = 0.85f;         // adaptive splitting threshold in [0, 1]
+  uint32_t seed = 1;
+};
+
+struct MaterialDesc {
+  std::string name;
+  Material gpu; // device record: type + albedo
+};
+
+// All geometry flattened into one world-space triangle soup. Emissive mesh triangles (OBJ/MTL Ke
+// or an emission given in the scene) have a TRIANGLE light with LIGHT_FLAG_FROM_MESH and
+// triangle_light[i] pointing at it. Analytic area lights (sphere, quad, triangle) are NOT in this
+// soup: the accel builder adds their primitives from `lights`.
+struct Scene {
+  std::filesystem::path path; // the scene file, for messages
+  Camera camera;
+  FilmSettings film;
+  IntegratorSettings integrator;
+  std::vector<MaterialDesc> materials; // at least one; index 0 is the default
+  std::vector<float3> vertices;
+  std::vector<uint32_t> indices;          // 3 per triangle
+  std::vector<int32_t> triangle_material; // per triangle
+  std::vector<int32_t> triangle_light;    // per triangle, -1 if not emissive
+  std::vector<Light> lights;
+
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// Loads and validates a scene file. Relative paths inside (OBJ files) are resolved against the
+// scene file's directory. Throws SceneError on any invalid input.
+Scene load_scene(const std::filesystem::path& file);
+
+// Same, from a JSON string; `name` is used in messages and `base_dir` resolves relative paths.
+Scene load_scene_from_string(const std::string& json_text, const std::string& name,
+                             const std::filesystem::path& base_dir);
+
+} // namespace canopy
