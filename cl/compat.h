@@ -14,6 +14,7 @@
 #define make_float3(a, b, c) ((float3)((a), (b), (c)))
 #define make_float4(a, b, c, d) ((float4)((a), (b), (c), (d)))
 #define make_int4(a, b, c, d) ((int4)((a), (b), (c), (d)))
+#define make_int2(a, b) ((int2)((a), (b)))
 #define xyz_of(v) ((v).xyz)
 #define FLT_INF INFINITY
 #pragma OPENCL FP_CONTRACT OFF
@@ -55,12 +56,18 @@ struct alignas(16) float4 {
 struct alignas(16) int4 {
   int x, y, z, w;
 };
+struct alignas(8) int2 {
+  int x, y;
+};
 static_assert(sizeof(float4) == 16 && sizeof(int4) == 16);
 
 INLINE float2 make_float2(float a, float b) { return {a, b}; }
 INLINE float3 make_float3(float a, float b, float c) { return {a, b, c}; }
 INLINE float4 make_float4(float a, float b, float c, float d) { return {a, b, c, d}; }
 INLINE int4 make_int4(int a, int b, int c, int d) { return {a, b, c, d}; }
+INLINE int2 make_int2(int a, int b) { return {a, b}; }
+using std::min;
+using std::max;
 INLINE float3 xyz_of(float4 v) { return {v.x, v.y, v.z}; }
 INLINE float4 f4_from3(float3 v, float w) { return {v.x, v.y, v.z, w}; }
 INLINE float f4_get(float4 v, int i) {

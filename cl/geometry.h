@@ -4,6 +4,7 @@
 #define CANOPY_CL_GEOMETRY_H
 
 #include "compat.h"
+#include "kernel_features.h"
 #include "types.h"
 
 #define BVH_STACK_SIZE 64
@@ -67,7 +68,7 @@ INLINE int ray_sphere(float3 o, float3 d, float3 c, float r, float tmin, float t
 
 INLINE int ray_primitive(const GLOBAL Primitive* prim, float3 o, float3 d, float tmin, float tmax,
                          float* t, float* u, float* v) {
-  if (prim->type == PRIM_SPHERE) {
+  if (HAS_PRIM_SPHERE && prim->type == PRIM_SPHERE) {
     *u = 0.0f;
     *v = 0.0f;
     return ray_sphere(o, d, xyz_of(prim->v0), prim->v0.w, tmin, tmax, t);
@@ -132,7 +133,7 @@ INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL int* prim_ind
 
 // Geometric normal of a primitive at a hit point (not normalised to face the ray).
 INLINE float3 primitive_normal(const GLOBAL Primitive* prim, float3 p) {
-  if (prim->type == PRIM_SPHERE) return normalize(p - xyz_of(prim->v0));
+  if (HAS_PRIM_SPHERE && prim->type == PRIM_SPHERE) return normalize(p - xyz_of(prim->v0));
   return normalize(cross(xyz_of(prim->e1), xyz_of(prim->e2)));
 }
 

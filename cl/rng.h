@@ -17,18 +17,18 @@ INLINE uint hash_u32(uint x) {
   return x;
 }
 
-typedef struct Rng {
+typedef struct PathRng {
   uint state;
-} Rng;
+} PathRng;
 
-INLINE Rng rng_seed(uint seed, uint pixel, uint sample) {
-  Rng r;
+INLINE PathRng rng_seed(uint seed, uint pixel, uint sample) {
+  PathRng r;
   r.state = hash_u32(seed ^ hash_u32(pixel ^ hash_u32(sample + 0x9e3779b9U)));
   return r;
 }
 
 // PCG-RXS-M-XS 32/32 (O'Neill 2014): one LCG step, then an output permutation.
-INLINE uint rng_next_u32(Rng* r) {
+INLINE uint rng_next_u32(PathRng* r) {
   uint s = r->state;
   r->state = s * 747796405U + 2891336453U;
   uint word = ((s >> ((s >> 28U) + 4U)) ^ s) * 277803737U;
@@ -36,6 +36,6 @@ INLINE uint rng_next_u32(Rng* r) {
 }
 
 // Uniform in [0, 1): the top 24 bits, so the result is exactly representable and never 1.
-INLINE float rng_next_float(Rng* r) { return (float)(rng_next_u32(r) >> 8) * (1.0f / 16777216.0f); }
+INLINE float rng_next_float(PathRng* r) { return (float)(rng_next_u32(r) >> 8) * (1.0f / 16777216.0f); }
 
 #endif // CANOPY_CL_RNG_H

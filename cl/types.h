@@ -87,4 +87,23 @@ typedef struct ShadowItem {
   float4 contribution; // rgb
 } ShadowItem;
 
+// A cluster of lights waiting in the split queue (Conty Estevez & Kulla 2018, Alg. 3 unrolled into
+// passes): `code` is a light-tree node or leaf (cl/light_tree_math.h), `sphere` and `cv2` its
+// bounding sphere and energy CV^2 (the split measure's inputs), `budget` the cut size it may still
+// spend.
+typedef struct SplitItem {
+  float4 sphere;
+  int path;
+  int code;
+  uint budget;
+  float cv2;
+} SplitItem;
+
+// Light samplers (compile-time CANOPY_LIGHT_SAMPLER in the kernels; a run-time value on the host).
+#define SAMPLER_UNIFORM 0
+#define SAMPLER_POWER 1
+#define SAMPLER_TREE 2
+#define SAMPLER_TREE_SPLIT 3
+#define SAMPLER_EXHAUSTIVE 4
+
 #endif // CANOPY_CL_TYPES_H

@@ -4,6 +4,7 @@
 #include "accel/bvh.h"
 #include "cl/runtime.h"
 #include "geometry.h"
+#include "support/procedural_mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -11,76 +12,13 @@
 #include <random>
 
 using namespace canopy;
+using canopy::testing::make_mesh;
+using canopy::testing::make_rays;
+using canopy::testing::Rays;
 
 namespace {
 
 constexpr int kRays = 100000;
-
-// A bumpy torus (96 x 48 quads, 9216 triangles) plus 2000 random small triangles around it: a
-// mesh with curved, concave and overlapping parts, and a wide range of triangle sizes.
-std::vector<Primitive> make_mesh() {
-  std::vector<Primitive> prims;
-  auto tri = [&](float3 a, float3 b, float3 c) {
-    Primitive p{};
-    p.v0 = f4_from3(a, 0);
-    p.e1 = f4_from3(b - a, 0);
-    p.e2 = f4_from3(c - a, 0);
-    p.type = PRIM_TRIANGLE;
-    p.light = -1;
-    prims.push_back(p);
-  };
-  const int nu = 96, nv = 48;
-  auto torus = [](int i, int j) {
-    float u = 2.0f * float(M_PI) * float(i) / 96.0f, v = 2.0f * float(M_PI) * float(j) / 48.0f;
-    float r = 0.4f * (1.0f + 0.15f * std::sin(5.0f * u) * std::cos(3.0f * v));
-    return make_float3((1.0f + r * std::cos(v)) * std::cos(u), r * std::sin(v),
-                       (1.0f + r * std::cos(v)) * std::sin(u));
-  };
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      float3 a = torus(i, j), b = torus(i + 1, j), c = torus(i + 1, j + 1), d = torus(i, j + 1);
-      tri(a, b, c);
-      tri(a, c, d);
-    }
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<float> pos(-2.0f, 2.0f), off(-0.2f, 0.2f);
-  for (int k = 0; k < 2000; ++k) {
-    float3 a = make_float3(pos(rng), pos(rng), pos(rng));
-    tri(a, a + make_float3(off(rng), off(rng), off(rng)), a + make_float3(off(rng), off(rng), off(rng)));
-  }
-  return prims;
-}
-
-struct Rays {
-  std::vector<float4> o, d;
-};
-
-// Half the rays start anywhere in a box around the mesh with random directions; half are aimed at
-// random points on random triangles, so most of those hit.
-Rays make_rays(const std::vector<Primitive>& prims) {
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f), pos(-3.0f, 3.0f);
-  std::uniform_int_distribution<size_t> pick(0, prims.size() - 1);
-  Rays r;
-  for (int i = 0; i < kRays; ++i) {
-    float3 o = make_float3(pos(rng), pos(rng), pos(rng));
-    float3 d;
-    if (i % 2 == 0) {
-      float z = 2.0f * u(rng) - 1.0f, phi = 2.0f * float(M_PI) * u(rng);
-      float s = std::sqrt(std::max(0.0f, 1.0f - z * z));
-      d = make_float3(s * std::cos(phi), s * std::sin(phi), z);
-    } else {
-      const Primitive& p = prims[pick(rng)];
-      float a = u(rng), b = u(rng);
-      if (a + b > 1.0f) a = 1.0f - a, b = 1.0f - b;
-      float3 target = xyz_of(p.v0) + xyz_of(p.e1) * a + xyz_of(p.e2) * b;
-      d = normalize(target - o);
-    }
-    r.o.push_back(f4_from3(o, 0.0f));
-    r.d.push_back(f4_from3(d, 0.0f));
-  }
-  return r;
-}
 
 bool close_rel(float a, float b, float rel) { return std::fabs(a - b) <= rel * std::max(std::fabs(a), std::fabs(b)); }
 
@@ -222,22 +160,21 @@ TEST_F(IntersectTest, OcclusionMatchesEmbree) {
     s.dir.w = uint_as_float_(uint(i));
     s.contribution = make_float4(1, 1, 1, 0);
   }
-  std::vector<float4> radiance(static_cast<size_t>(kRays), make_float4(0, 0, 0, 0));
   cl::Buffer b_nodes = buffer(bvh_->nodes), b_idx = buffer(bvh_->prim_index), b_prims = buffer(*prims_),
-             b_items = buffer(items), b_rad = buffer(radiance);
+             b_items = buffer(items);
   cl::Kernel k(*program_, "intersect_shadow");
   k.setArg(0, b_nodes);
   k.setArg(1, b_idx);
   k.setArg(2, b_prims);
   k.setArg(3, b_items);
   k.setArg(4, cl_int(kRays));
-  k.setArg(5, b_rad);
   enqueue_1d(rt_->queue(), k, size_t(kRays));
-  rt_->queue().enqueueReadBuffer(b_rad, CL_TRUE, 0, radiance.size() * sizeof(float4), radiance.data());
+  std::vector<ShadowItem> result(items.size());
+  rt_->queue().enqueueReadBuffer(b_items, CL_TRUE, 0, result.size() * sizeof(ShadowItem), result.data());
   int occluded = 0, disagree = 0;
   for (int i = 0; i < kRays; ++i) {
     const ShadowItem& s = items[size_t(i)];
-    bool kernel_occluded = radiance[size_t(i)].x == 0.0f;
+    bool kernel_occluded = result[size_t(i)].contribution.x == 0.0f; // zeroed when occluded
     bool embree_occluded = embree.occluded(xyz_of(s.origin), xyz_of(s.dir), 0.0f, s.origin.w);
     occluded += embree_occluded;
     disagree += kernel_occluded != embree_occluded;

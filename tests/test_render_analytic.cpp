@@ -132,14 +132,17 @@ const std::vector<PointLight> kLights = {
 
 } // namespace
 
-class AnalyticPlane : public ::testing::TestWithParam<float> {};
+class AnalyticPlane : public ::testing::TestWithParam<std::tuple<std::string, float>> {};
 
 TEST_P(AnalyticPlane, PixelMeansMatchTheAnalyticRadiance) {
-  const float scale = GetParam();
+  const std::string sampler = std::get<0>(GetParam());
+  const float scale = std::get<1>(GetParam());
   const float3 albedo = make_float3(0.8f, 0.5f, 0.3f);
   Scene scene = make_plane_scene(scale, kLights, albedo);
   ClRuntime rt;
-  Renderer renderer(rt, scene);
+  RendererOptions opt;
+  opt.light_sampler = sampler;
+  Renderer renderer(rt, scene, opt);
   RenderSettings rs;
   rs.spp = 2048;
   rs.seed = 3;
@@ -148,7 +151,7 @@ TEST_P(AnalyticPlane, PixelMeansMatchTheAnalyticRadiance) {
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
   for (const float4& s : film.sum) ASSERT_EQ(s.w, 2048.0f);
   Check c = compare_with_analytic(scene, film, albedo);
-  std::printf("scale %g: %d values checked, mean relative bound %.4f\n", double(scale), c.checked, c.mean_rel_bound);
+  std::printf("%s, scale %g: %d values checked, mean relative bound %.4f\n", sampler.c_str(), double(scale), c.checked, c.mean_rel_bound);
   EXPECT_EQ(c.violations, 0);
   double total_bound = 5.0 * std::sqrt(c.total_var) + c.total_quad + 1e-5 * c.total_ref;
   std::printf("image total %.6g vs analytic %.6g (bound %.3g, %.3f%%)\n", c.total_mean, c.total_ref,
@@ -160,13 +163,23 @@ TEST_P(AnalyticPlane, PixelMeansMatchTheAnalyticRadiance) {
   EXPECT_LT(c.mean_rel_bound, 0.2);
 }
 
-INSTANTIATE_TEST_SUITE_P(Scales, AnalyticPlane, ::testing::Values(1.0f, 1e-3f, 1e3f));
+INSTANTIATE_TEST_SUITE_P(
+    SamplersAndScales, AnalyticPlane,
+    ::testing::Combine(::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive"),
+                       ::testing::Values(1.0f, 1e-3f, 1e3f)),
+    [](const auto& p) {
+      std::string name = std::get<0>(p.param) + "_scale_" +
+                         std::to_string(int(std::log10(std::get<1>(p.param)) + 3.5f) - 3);
+      for (char& c : name)
+        if (c == '-') c = '_';
+      return name;
+    });
 
 TEST(AnalyticPlaneDeterminism, SameSeedSameImage) {
   const float3 albedo = make_float3(0.5f, 0.5f, 0.5f);
   Scene scene = make_plane_scene(1.0f, kLights, albedo);
   ClRuntime rt;
-  Renderer renderer(rt, scene);
+  Renderer renderer(rt, scene, RendererOptions{});
   RenderSettings rs;
   rs.spp = 8;
   rs.seed = 9;

@@ -1,4 +1,4 @@
-// Stage 5: add the wave's path radiance into the film. One work item per pixel, visiting that
+// Stage 6: add the wave's path radiance into the film. One work item per pixel, visiting that
 // pixel's paths in increasing order, so the sum is race-free and deterministic even when a wave
 // holds several samples of the same pixel. film_sum.w counts samples; film_sumsq holds the
 // per-channel second moment for variance estimates. A non-finite sample never reaches the film:

@@ -14,7 +14,7 @@ __kernel void generate(__global const CameraParams* cam, uint seed, ulong wave_b
   ulong npix = (ulong)cam->width * (ulong)cam->height;
   uint pixel = (uint)(g % npix);
   uint pass = (uint)(g / npix);
-  Rng r = rng_seed(seed, pixel, pass);
+  PathRng r = rng_seed(seed, pixel, pass);
   float jx = rng_next_float(&r);
   float jy = rng_next_float(&r);
   float x = (float)(pixel % (uint)cam->width) + jx;

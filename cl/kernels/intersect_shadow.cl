@@ -1,17 +1,27 @@
-// Stage 4: occlusion of the shadow queue. An unoccluded item adds its contribution to its path.
-// Each path pushes at most one shadow item per bounce, so the add below never races; the
-// split-queue renderer (several items per path) replaces it with a per-path reduction.
+// Stage 5: occlusion of one pass's shadow queue, then the per-path sum. The queue holds each
+// path's items contiguously (the split queue stays grouped by path from pass to pass), so the
+// first item of each run adds the run's visible contributions in queue order: race-free and
+// deterministic, however many shadow rays a path has.
 #include "geometry.h"
 
 __kernel void intersect_shadow(__global const BvhNode* nodes, __global const int* prim_index,
-                               __global const Primitive* prims, __global const ShadowItem* items,
-                               int count, __global float4* radiance) {
+                               __global const Primitive* prims, __global ShadowItem* items,
+                               int count) {
   int i = get_global_id(0);
   if (i >= count) return;
   ShadowItem s = items[i];
   Hit h;
   if (bvh_intersect(nodes, prim_index, prims, s.origin.xyz, s.dir.xyz, 0.0f, s.origin.w, 1, &h) >= 0)
-    return;
-  int path = as_int(s.dir.w);
-  radiance[path] += (float4)(s.contribution.xyz, 0.0f);
+    items[i].contribution = (float4)(0.0f);
+}
+
+__kernel void accumulate_shadow(__global const ShadowItem* items, int count,
+                                __global float4* radiance) {
+  int i = get_global_id(0);
+  if (i >= count) return;
+  int path = as_int(items[i].dir.w);
+  if (i > 0 && as_int(items[i - 1].dir.w) == path) return; // not the first of its run
+  float3 sum = (float3)(0.0f);
+  for (int j = i; j < count && as_int(items[j].dir.w) == path; ++j) sum += items[j].contribution.xyz;
+  radiance[path] += (float4)(sum, 0.0f);
 }

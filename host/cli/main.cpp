@@ -6,6 +6,7 @@
 #include "cl/runtime.h"
 #include "image/image_io.h"
 #include "render/renderer.h"
+#include "render/stats_report.h"
 #include "scene/scene.h"
 
 #include <CLI/CLI.hpp>
@@ -14,6 +15,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 
 namespace {
@@ -31,7 +33,8 @@ struct RenderArgs {
   std::optional<int> spp;
   std::optional<uint32_t> seed;
   std::optional<std::string> light_sampler;
-  std::string out, png, device;
+  std::string out, png, device, stats_json;
+  bool stats = false;
 };
 
 // A progress bar on stderr, shown only once a render has run for a second.
@@ -59,7 +62,11 @@ private:
 };
 
 int run_render(const RenderArgs& args) {
+  auto t_start = std::chrono::steady_clock::now();
   Scene scene = load_scene(args.scene);
+  RunTimings timings;
+  timings.load_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (args.spp) {
     if (*args.spp < 1 || *args.spp > 1000000)
       throw SceneError(fmt::format("--spp: must be in [1, 1000000], got {}", *args.spp));
@@ -67,17 +74,16 @@ int run_render(const RenderArgs& args) {
   }
   if (args.seed) scene.integrator.seed = *args.seed;
   if (args.light_sampler) scene.integrator.light_sampler = *args.light_sampler;
-  if (!device_supports_light_sampler(scene.integrator.light_sampler))
-    throw SceneError(fmt::format("light sampler '{}' is not available in the device renderer yet "
-                                 "(available: uniform)",
-                                 scene.integrator.light_sampler));
 
   fs::path stem = fs::path(args.scene).stem();
   fs::path exr = args.out.empty() ? fs::path("out") / (stem.string() + ".exr") : fs::path(args.out);
   fs::path png = args.png.empty() ? fs::path(exr).replace_extension(".png") : fs::path(args.png);
 
   ClRuntime rt(args.device);
-  Renderer renderer(rt, scene);
+  RendererOptions ropt;
+  ropt.light_sampler = scene.integrator.light_sampler;
+  ropt.split_threshold = scene.integrator.split_threshold;
+  Renderer renderer(rt, scene, ropt);
   ProgressBar bar;
   RenderSettings settings;
   settings.spp = scene.integrator.spp;
@@ -103,6 +109,21 @@ int run_render(const RenderArgs& args) {
                                                   st.nonfinite_samples)
                                           .c_str()
                                     : "");
+  timings.total_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  if (args.stats) std::fprintf(stderr, "%s", stats_to_table(st, timings).c_str());
+  if (!args.stats_json.empty()) {
+    nlohmann::json j = stats_to_json(st, timings);
+    j["scene"] = args.scene;
+    j["light_sampler"] = scene.integrator.light_sampler;
+    j["spp"] = scene.integrator.spp;
+    j["film"] = {scene.film.width, scene.film.height};
+    j["lights"] = scene.lights.size();
+    j["device"] = rt.device_name();
+    std::ofstream out(args.stats_json);
+    if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.stats_json));
+    out << j.dump(2) << "\n";
+  }
   std::printf("wrote %s\nwrote %s\n", exr.string().c_str(), png.string().c_str());
   return 0;
 }
@@ -137,6 +158,8 @@ int main(int argc, char** argv) {
   render->add_option("--light-sampler", rargs.light_sampler, "Light sampler (overrides the scene)")
       ->check(CLI::IsMember(std::vector<std::string>(std::begin(kSamplers), std::end(kSamplers))));
   render->add_option("--device", rargs.device, "OpenCL device name substring (see `canopy info`)");
+  render->add_flag("--stats", rargs.stats, "Print per-stage times, throughput and cut sizes");
+  render->add_option("--stats-json", rargs.stats_json, "Write the statistics as JSON to FILE");
 
   CLI::App* info = app.add_subcommand("info", "List OpenCL platforms and devices");
 

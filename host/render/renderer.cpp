@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include "lighttree/light_sampler.h"
 #include "render/camera.h"
 
 #include <fmt/format.h>
@@ -24,13 +25,19 @@ template <class T> cl::Buffer upload(const cl::Context& ctx, const std::vector<T
   return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(v.data()));
 }
 
+cl::Buffer device_buffer(const cl::Context& ctx, size_t bytes) {
+  return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<size_t>(bytes, 16));
+}
+
 const std::vector<std::string> kKernelFiles = {
-    "kernels/generate.cl", "kernels/intersect_closest.cl", "kernels/shade_surface.cl",
-    "kernels/intersect_shadow.cl", "kernels/accumulate.cl"};
+    "kernels/compact.cl",      "kernels/generate.cl",         "kernels/intersect_closest.cl",
+    "kernels/shade_surface.cl", "kernels/light_pick.cl",      "kernels/intersect_shadow.cl",
+    "kernels/accumulate.cl"};
+
+constexpr int kScanBlock = 256;
+constexpr int kCutBins = 65;
 
 } // namespace
-
-bool device_supports_light_sampler(const std::string& name) { return name == "uniform"; }
 
 RgbImage Film::mean() const {
   RgbImage img;
@@ -46,10 +53,37 @@ RgbImage Film::mean() const {
   return img;
 }
 
-Renderer::Renderer(ClRuntime& rt, Scene& scene) : rt_(rt), scene_(scene) {
+Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
+    : rt_(rt), scene_(scene), options_(options) {
+  sampler_kind_ = light_sampler_from_name(options.light_sampler);
+  const bool splits = sampler_kind_ == SAMPLER_TREE_SPLIT || sampler_kind_ == SAMPLER_EXHAUSTIVE;
+  const uint32_t n_lights = uint32_t(scene.lights.size());
+  if (sampler_kind_ == SAMPLER_EXHAUSTIVE)
+    max_cut_ = std::max<uint32_t>(1, n_lights); // every light: the budget never binds
+  else if (sampler_kind_ == SAMPLER_TREE_SPLIT)
+    max_cut_ = uint32_t(std::clamp(options.max_cut, 1, int(std::max<uint32_t>(1, n_lights))));
+  else
+    max_cut_ = 1;
+  (void)splits;
+
   auto t0 = Clock::now();
   for (const MaterialDesc& m : scene.materials) materials_.push_back(m.gpu);
   geometry_ = build_scene_geometry(scene, materials_);
+  auto t1 = Clock::now();
+  const bool uses_tree = sampler_kind_ >= SAMPLER_TREE;
+  if (uses_tree) tree_ = build_light_tree(scene.lights);
+  stats_.light_tree_seconds = seconds_since(t1);
+  std::vector<float> power_pmf, alias_prob;
+  std::vector<int> alias_index;
+  if (sampler_kind_ == SAMPLER_POWER) {
+    std::vector<EmitterBounds> eb = emitter_bounds(scene.lights);
+    std::vector<double> w(eb.size());
+    for (size_t i = 0; i < eb.size(); ++i) w[i] = eb[i].energy;
+    AliasTable table(w);
+    power_pmf = table.pmfs();
+    alias_prob = table.thresholds();
+    alias_index = table.aliases();
+  }
   stats_.build_seconds = seconds_since(t0);
 
   t0 = Clock::now();
@@ -62,11 +96,48 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene) : rt_(rt), scene_(scene) {
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
   camera_ = upload(ctx, cam);
+  power_pmf_ = upload(ctx, power_pmf);
+  alias_prob_ = upload(ctx, alias_prob);
+  alias_index_ = upload(ctx, alias_index);
+  lt_nodes_ = upload(ctx, tree_.nodes);
+  lt_children_ = upload(ctx, tree_.children);
+  lt_leaf_lights_ = upload(ctx, tree_.leaf_lights);
+  lt_trails_ = upload(ctx, tree_.trails);
   stats_.upload_seconds = seconds_since(t0);
 
   t0 = Clock::now();
-  program_ = rt.build_program(kKernelFiles);
+  KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_kind_)
+                                                 : scene_features(scene, sampler_kind_);
+  stats_.kernel_options = features.build_options();
+  program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
+  stats_.cut_size_histogram.assign(kCutBins, 0);
+}
+
+int Renderer::set_scene_args(cl::Kernel& k, int i) const {
+  k.setArg(i++, nodes_);
+  k.setArg(i++, prim_index_);
+  k.setArg(i++, prims_);
+  k.setArg(i++, materials_buf_);
+  k.setArg(i++, cl_float(geometry_.ray_eps));
+  return i;
+}
+
+int Renderer::set_light_sampler_args(cl::Kernel& k, int i) const {
+  k.setArg(i++, cl_int(scene_.lights.size()));
+  k.setArg(i++, lights_);
+  k.setArg(i++, power_pmf_);
+  k.setArg(i++, alias_prob_);
+  k.setArg(i++, alias_index_);
+  k.setArg(i++, lt_nodes_);
+  k.setArg(i++, lt_children_);
+  k.setArg(i++, lt_leaf_lights_);
+  k.setArg(i++, lt_trails_);
+  k.setArg(i++, tree_.root_sphere);
+  k.setArg(i++, tree_.root_info);
+  k.setArg(i++, cl_float(options_.split_threshold));
+  k.setArg(i++, cl_uint(max_cut_));
+  return i;
 }
 
 Film Renderer::render(const RenderSettings& settings) {
@@ -76,120 +147,216 @@ Film Renderer::render(const RenderSettings& settings) {
   const int width = scene_.film.width, height = scene_.film.height;
   const int npix = width * height;
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
-  const size_t W = size_t(std::min<uint64_t>(total, std::max<size_t>(1, settings.wave_size)));
+  // Every path's cut has at most max_cut_ items in any pass, so waves of
+  // split_queue_items / max_cut_ paths bound the split queue.
+  size_t wave = std::max<size_t>(1, std::min(settings.wave_size, options_.split_queue_items / max_cut_));
+  const size_t W = size_t(std::min<uint64_t>(total, wave));
+  const size_t split_cap = W * max_cut_;
   const int max_depth = scene_.integrator.max_depth;
-  const int light_count = int(scene_.lights.size());
 
   // Path state (struct of arrays) and queues, sized for one wave.
-  cl::Buffer ray_o(ctx, CL_MEM_READ_WRITE, W * sizeof(float4));
-  cl::Buffer ray_d(ctx, CL_MEM_READ_WRITE, W * sizeof(float4));
-  cl::Buffer throughput(ctx, CL_MEM_READ_WRITE, W * sizeof(float4));
-  cl::Buffer radiance(ctx, CL_MEM_READ_WRITE, W * sizeof(float4));
-  cl::Buffer rng(ctx, CL_MEM_READ_WRITE, W * sizeof(cl_uint));
-  cl::Buffer hits(ctx, CL_MEM_READ_WRITE, W * sizeof(Hit));
-  cl::Buffer queue_a(ctx, CL_MEM_READ_WRITE, W * sizeof(cl_int));
-  cl::Buffer queue_b(ctx, CL_MEM_READ_WRITE, W * sizeof(cl_int));
-  cl::Buffer shadow(ctx, CL_MEM_READ_WRITE, W * sizeof(ShadowItem));
-  cl::Buffer counters(ctx, CL_MEM_READ_WRITE, 4 * sizeof(cl_int));
-  cl::Buffer nonfinite(ctx, CL_MEM_READ_WRITE, sizeof(cl_int));
-  cl::Buffer film_sum(ctx, CL_MEM_READ_WRITE, size_t(npix) * sizeof(float4));
-  cl::Buffer film_sumsq(ctx, CL_MEM_READ_WRITE, size_t(npix) * sizeof(float4));
+  cl::Buffer ray_o = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer ray_d = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer throughput = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer radiance = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer rng = device_buffer(ctx, W * sizeof(cl_uint));
+  cl::Buffer hits = device_buffer(ctx, W * sizeof(Hit));
+  cl::Buffer shade_P = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer shade_N = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer shade_f = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer queue_a = device_buffer(ctx, W * sizeof(cl_int));
+  cl::Buffer queue_b = device_buffer(ctx, W * sizeof(cl_int));
+  cl::Buffer counts_shade = device_buffer(ctx, W * sizeof(cl_int2));
+  cl::Buffer cut_size = device_buffer(ctx, W * sizeof(cl_int));
+  cl::Buffer split_a = device_buffer(ctx, split_cap * sizeof(SplitItem));
+  cl::Buffer split_b = device_buffer(ctx, split_cap * sizeof(SplitItem));
+  cl::Buffer child_stage = device_buffer(ctx, 4 * split_cap * sizeof(SplitItem));
+  cl::Buffer shadow_stage = device_buffer(ctx, 4 * split_cap * sizeof(ShadowItem));
+  cl::Buffer shadow = device_buffer(ctx, split_cap * sizeof(ShadowItem));
+  cl::Buffer counts = device_buffer(ctx, split_cap * sizeof(cl_int2));
+  cl::Buffer offsets = device_buffer(ctx, split_cap * sizeof(cl_int2));
+  cl::Buffer block_sums = device_buffer(ctx, (split_cap / kScanBlock + 2) * sizeof(cl_int2));
+  cl::Buffer totals = device_buffer(ctx, 2 * sizeof(cl_int));
+  cl::Buffer histogram = device_buffer(ctx, kCutBins * sizeof(cl_int));
+  cl::Buffer nonfinite = device_buffer(ctx, sizeof(cl_int));
+  cl::Buffer film_sum = device_buffer(ctx, size_t(npix) * sizeof(float4));
+  cl::Buffer film_sumsq = device_buffer(ctx, size_t(npix) * sizeof(float4));
   const float4 zero4 = make_float4(0, 0, 0, 0);
   q.enqueueFillBuffer(film_sum, zero4, 0, size_t(npix) * sizeof(float4));
   q.enqueueFillBuffer(film_sumsq, zero4, 0, size_t(npix) * sizeof(float4));
   q.enqueueFillBuffer(nonfinite, cl_int(0), 0, sizeof(cl_int));
+  q.enqueueFillBuffer(histogram, cl_int(0), 0, kCutBins * sizeof(cl_int));
 
   cl::Kernel k_generate(program_, "generate");
   cl::Kernel k_closest(program_, "intersect_closest");
   cl::Kernel k_shade(program_, "shade_surface");
+  cl::Kernel k_scatter_shade(program_, "scatter_shade");
+  cl::Kernel k_pick(program_, "light_pick");
+  cl::Kernel k_scatter_split(program_, "scatter_split");
+  cl::Kernel k_histogram(program_, "cut_histogram");
   cl::Kernel k_shadow(program_, "intersect_shadow");
+  cl::Kernel k_shadow_sum(program_, "accumulate_shadow");
   cl::Kernel k_accumulate(program_, "accumulate");
+  cl::Kernel k_scan_blocks(program_, "scan_blocks");
+  cl::Kernel k_scan_sums(program_, "scan_block_sums");
 
-  std::vector<std::pair<std::string, cl::Event>> events;
-  auto record = [&](const char* stage, const cl::Event& ev, size_t items) {
-    events.emplace_back(stage, ev);
+  std::vector<std::pair<const char*, cl::Event>> events;
+  auto run = [&](const char* stage, cl::Kernel& k, size_t n) {
+    if (n == 0) return;
+    events.emplace_back(stage, enqueue_1d(q, k, n));
     StageStats& s = stats_.stages[stage];
-    s.items += items;
+    s.items += n;
     s.launches += 1;
+  };
+  auto path_args = [&](cl::Kernel& k, int i) {
+    for (cl::Buffer* b : {&ray_o, &ray_d, &throughput, &radiance, &rng, &hits, &shade_P, &shade_N,
+                          &shade_f})
+      k.setArg(i++, *b);
+    return i;
+  };
+  // Exclusive scan of the count pairs in `c` (n items); returns the two totals.
+  auto scan = [&](const cl::Buffer& c, int n) {
+    int blocks = (n + kScanBlock - 1) / kScanBlock;
+    k_scan_blocks.setArg(0, c);
+    k_scan_blocks.setArg(1, cl_int(n));
+    k_scan_blocks.setArg(2, cl_int(kScanBlock));
+    k_scan_blocks.setArg(3, offsets);
+    k_scan_blocks.setArg(4, block_sums);
+    run("scan", k_scan_blocks, size_t(blocks));
+    k_scan_sums.setArg(0, block_sums);
+    k_scan_sums.setArg(1, cl_int(blocks));
+    k_scan_sums.setArg(2, totals);
+    run("scan", k_scan_sums, 1);
+    cl_int t[2];
+    q.enqueueReadBuffer(totals, CL_TRUE, 0, sizeof(t), t);
+    return std::pair<int, int>(t[0], t[1]);
+  };
+  auto scan_args = [&](cl::Kernel& k, int i, const cl::Buffer& c) {
+    k.setArg(i++, c);
+    k.setArg(i++, offsets);
+    k.setArg(i++, block_sums);
+    k.setArg(i++, cl_int(kScanBlock));
+    return i;
   };
 
   for (uint64_t base = 0; base < total; base += W) {
     const int count0 = int(std::min<uint64_t>(W, total - base));
-    k_generate.setArg(0, camera_);
-    k_generate.setArg(1, cl_uint(settings.seed));
-    k_generate.setArg(2, cl_ulong(base));
-    k_generate.setArg(3, cl_int(count0));
-    k_generate.setArg(4, ray_o);
-    k_generate.setArg(5, ray_d);
-    k_generate.setArg(6, throughput);
-    k_generate.setArg(7, radiance);
-    k_generate.setArg(8, rng);
-    k_generate.setArg(9, queue_a);
-    record("generate", enqueue_1d(q, k_generate, size_t(count0)), size_t(count0));
+    int a = 0;
+    k_generate.setArg(a++, camera_);
+    k_generate.setArg(a++, cl_uint(settings.seed));
+    k_generate.setArg(a++, cl_ulong(base));
+    k_generate.setArg(a++, cl_int(count0));
+    k_generate.setArg(a++, ray_o);
+    k_generate.setArg(a++, ray_d);
+    k_generate.setArg(a++, throughput);
+    k_generate.setArg(a++, radiance);
+    k_generate.setArg(a++, rng);
+    k_generate.setArg(a++, queue_a);
+    run("generate", k_generate, size_t(count0));
 
     cl::Buffer* q_in = &queue_a;
     cl::Buffer* q_out = &queue_b;
     int count = count0;
     for (int depth = 0; depth < max_depth && count > 0; ++depth) {
-      k_closest.setArg(0, nodes_);
-      k_closest.setArg(1, prim_index_);
-      k_closest.setArg(2, prims_);
-      k_closest.setArg(3, *q_in);
-      k_closest.setArg(4, cl_int(count));
-      k_closest.setArg(5, ray_o);
-      k_closest.setArg(6, ray_d);
-      k_closest.setArg(7, hits);
-      record("intersect_closest", enqueue_1d(q, k_closest, size_t(count)), size_t(count));
+      a = 0;
+      k_closest.setArg(a++, nodes_);
+      k_closest.setArg(a++, prim_index_);
+      k_closest.setArg(a++, prims_);
+      k_closest.setArg(a++, *q_in);
+      k_closest.setArg(a++, cl_int(count));
+      k_closest.setArg(a++, ray_o);
+      k_closest.setArg(a++, ray_d);
+      k_closest.setArg(a++, hits);
+      run("intersect_closest", k_closest, size_t(count));
 
-      q.enqueueFillBuffer(counters, cl_int(0), 0, 4 * sizeof(cl_int));
-      int a = 0;
+      a = 0;
       k_shade.setArg(a++, cl_int(depth));
       k_shade.setArg(a++, cl_int(max_depth));
-      k_shade.setArg(a++, cl_float(geometry_.ray_eps));
-      k_shade.setArg(a++, cl_int(light_count));
       k_shade.setArg(a++, *q_in);
       k_shade.setArg(a++, cl_int(count));
-      k_shade.setArg(a++, *q_out);
-      k_shade.setArg(a++, counters);
-      k_shade.setArg(a++, ray_o);
-      k_shade.setArg(a++, ray_d);
-      k_shade.setArg(a++, throughput);
-      k_shade.setArg(a++, radiance);
-      k_shade.setArg(a++, rng);
-      k_shade.setArg(a++, hits);
-      k_shade.setArg(a++, prims_);
-      k_shade.setArg(a++, materials_buf_);
-      k_shade.setArg(a++, lights_);
-      k_shade.setArg(a++, shadow);
-      record("shade_surface", enqueue_1d(q, k_shade, size_t(count)), size_t(count));
+      a = path_args(k_shade, a);
+      a = set_scene_args(k_shade, a);
+      a = set_light_sampler_args(k_shade, a);
+      k_shade.setArg(a++, counts_shade);
+      run("shade_surface", k_shade, size_t(count));
 
-      cl_int c[4];
-      q.enqueueReadBuffer(counters, CL_TRUE, 0, sizeof(c), c);
-      const int next_count = c[0], shadow_count = c[1];
-      stats_.shadow_rays += uint64_t(shadow_count);
+      auto [next_count, shade_count] = scan(counts_shade, count);
+      a = 0;
+      k_scatter_shade.setArg(a++, *q_in);
+      k_scatter_shade.setArg(a++, cl_int(count));
+      a = scan_args(k_scatter_shade, a, counts_shade);
+      k_scatter_shade.setArg(a++, *q_out);
+      k_scatter_shade.setArg(a++, split_a);
+      k_scatter_shade.setArg(a++, tree_.root_sphere);
+      k_scatter_shade.setArg(a++, cl_float(tree_.root_info.x));
+      k_scatter_shade.setArg(a++, cl_uint(max_cut_));
+      run("scatter", k_scatter_shade, size_t(count));
+      stats_.shading_points += uint64_t(shade_count);
+      q.enqueueFillBuffer(cut_size, cl_int(0), 0, W * sizeof(cl_int));
 
-      k_shadow.setArg(0, nodes_);
-      k_shadow.setArg(1, prim_index_);
-      k_shadow.setArg(2, prims_);
-      k_shadow.setArg(3, shadow);
-      k_shadow.setArg(4, cl_int(shadow_count));
-      k_shadow.setArg(5, radiance);
-      record("intersect_shadow", enqueue_1d(q, k_shadow, size_t(shadow_count)),
-             size_t(shadow_count));
+      // Split passes: each pass consumes one level of the cut (DESIGN §4).
+      cl::Buffer* s_in = &split_a;
+      cl::Buffer* s_out = &split_b;
+      int n = shade_count;
+      while (n > 0) {
+        a = 0;
+        k_pick.setArg(a++, *s_in);
+        k_pick.setArg(a++, cl_int(n));
+        a = path_args(k_pick, a);
+        a = set_scene_args(k_pick, a);
+        a = set_light_sampler_args(k_pick, a);
+        k_pick.setArg(a++, child_stage);
+        k_pick.setArg(a++, shadow_stage);
+        k_pick.setArg(a++, counts);
+        k_pick.setArg(a++, cut_size);
+        run("light_pick", k_pick, size_t(n));
+        auto [n_children, n_shadow] = scan(counts, n);
+        a = 0;
+        k_scatter_split.setArg(a++, cl_int(n));
+        a = scan_args(k_scatter_split, a, counts);
+        k_scatter_split.setArg(a++, child_stage);
+        k_scatter_split.setArg(a++, shadow_stage);
+        k_scatter_split.setArg(a++, *s_out);
+        k_scatter_split.setArg(a++, shadow);
+        run("scatter", k_scatter_split, size_t(n));
+
+        a = 0;
+        k_shadow.setArg(a++, nodes_);
+        k_shadow.setArg(a++, prim_index_);
+        k_shadow.setArg(a++, prims_);
+        k_shadow.setArg(a++, shadow);
+        k_shadow.setArg(a++, cl_int(n_shadow));
+        run("intersect_shadow", k_shadow, size_t(n_shadow));
+        k_shadow_sum.setArg(0, shadow);
+        k_shadow_sum.setArg(1, cl_int(n_shadow));
+        k_shadow_sum.setArg(2, radiance);
+        run("accumulate_shadow", k_shadow_sum, size_t(n_shadow));
+        stats_.shadow_rays += uint64_t(n_shadow);
+        std::swap(s_in, s_out);
+        n = n_children;
+      }
+      a = 0;
+      k_histogram.setArg(a++, *q_in);
+      k_histogram.setArg(a++, cl_int(count));
+      k_histogram.setArg(a++, counts_shade);
+      k_histogram.setArg(a++, cut_size);
+      k_histogram.setArg(a++, histogram);
+      k_histogram.setArg(a++, cl_int(kCutBins));
+      run("cut_histogram", k_histogram, size_t(count));
 
       std::swap(q_in, q_out);
       count = next_count;
     }
 
-    k_accumulate.setArg(0, cl_ulong(base));
-    k_accumulate.setArg(1, cl_int(count0));
-    k_accumulate.setArg(2, cl_int(npix));
-    k_accumulate.setArg(3, radiance);
-    k_accumulate.setArg(4, film_sum);
-    k_accumulate.setArg(5, film_sumsq);
-    k_accumulate.setArg(6, nonfinite);
-    size_t acc_items = size_t(std::min<int64_t>(npix, count0));
-    record("accumulate", enqueue_1d(q, k_accumulate, size_t(npix)), acc_items);
+    a = 0;
+    k_accumulate.setArg(a++, cl_ulong(base));
+    k_accumulate.setArg(a++, cl_int(count0));
+    k_accumulate.setArg(a++, cl_int(npix));
+    k_accumulate.setArg(a++, radiance);
+    k_accumulate.setArg(a++, film_sum);
+    k_accumulate.setArg(a++, film_sumsq);
+    k_accumulate.setArg(a++, nonfinite);
+    run("accumulate", k_accumulate, size_t(npix));
     q.finish();
     for (auto& [stage, ev] : events) stats_.stages[stage].seconds += event_seconds(ev);
     events.clear();
@@ -207,6 +374,9 @@ Film Renderer::render(const RenderSettings& settings) {
   cl_int nf = 0;
   q.enqueueReadBuffer(nonfinite, CL_TRUE, 0, sizeof(nf), &nf);
   stats_.nonfinite_samples += uint64_t(nf);
+  std::vector<cl_int> hist(kCutBins);
+  q.enqueueReadBuffer(histogram, CL_TRUE, 0, kCutBins * sizeof(cl_int), hist.data());
+  for (int k = 0; k < kCutBins; ++k) stats_.cut_size_histogram[size_t(k)] += uint64_t(hist[size_t(k)]);
   stats_.render_seconds += seconds_since(t_start);
   return film;
 }

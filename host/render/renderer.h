@@ -7,6 +7,8 @@
 #include "accel/bvh.h"
 #include "cl/runtime.h"
 #include "image/image_io.h"
+#include "lighttree/light_tree.h"
+#include "render/features.h"
 #include "scene/scene.h"
 
 #include <cstdint>
@@ -17,8 +19,6 @@
 
 namespace canopy {
 
-// Light samplers the device renderer implements.
-bool device_supports_light_sampler(const std::string& name);
 
 struct StageStats {
   double seconds = 0.0; // summed kernel time from profiling events
@@ -27,12 +27,16 @@ struct StageStats {
 };
 
 struct RenderStats {
-  double build_seconds = 0.0;   // primitives + BVH
+  double build_seconds = 0.0;   // primitives + BVH + light tree
+  double light_tree_seconds = 0.0;
   double upload_seconds = 0.0;  // buffers to the device
   double compile_seconds = 0.0; // OpenCL program build
   double render_seconds = 0.0;  // wall time of render()
   uint64_t samples = 0;
+  uint64_t shading_points = 0; // surface hits shaded
   uint64_t shadow_rays = 0;
+  std::vector<uint64_t> cut_size_histogram; // shading points by number of shadow items pushed
+  std::string kernel_options;               // the -D options the kernels were compiled with
   uint64_t nonfinite_samples = 0; // samples that were not finite and were recorded as zero
   std::map<std::string, StageStats> stages;
 };
@@ -47,15 +51,23 @@ struct Film {
 struct RenderSettings {
   int spp = 1;
   uint32_t seed = 1;
-  size_t wave_size = size_t(1) << 18; // paths per wave
+  size_t wave_size = size_t(1) << 18; // paths per wave (smaller when splitting: see render())
   std::function<void(double fraction)> progress; // optional, called after each wave
+};
+
+struct RendererOptions {
+  std::string light_sampler = "tree-split"; // uniform | power | tree | tree-split | exhaustive
+  float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD;
+  int max_cut = 64;                 // cut size cap per shading point (tree-split)
+  bool all_features = false;        // compile every kernel feature (tests)
+  size_t split_queue_items = 1 << 20; // split-queue capacity per wave
 };
 
 class Renderer {
 public:
   // Builds the geometry and uploads it; compiles the kernels. `scene` lights get their `prim`
   // fields filled in.
-  Renderer(ClRuntime& rt, Scene& scene);
+  Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options);
 
   Film render(const RenderSettings& settings);
   const RenderStats& stats() const { return stats_; }
@@ -66,9 +78,18 @@ private:
   Scene& scene_;
   SceneGeometry geometry_;
   std::vector<Material> materials_;
+  RendererOptions options_;
+  int sampler_kind_ = 0;
+  uint32_t max_cut_ = 1;
+  LightTree tree_;
   RenderStats stats_;
   cl::Program program_;
   cl::Buffer nodes_, prim_index_, prims_, materials_buf_, lights_, camera_;
+  cl::Buffer power_pmf_, alias_prob_, alias_index_, lt_nodes_, lt_children_, lt_leaf_lights_,
+      lt_trails_;
+
+  int set_scene_args(cl::Kernel& k, int index) const;
+  int set_light_sampler_args(cl::Kernel& k, int index) const;
 };
 
 } // namespace canopy

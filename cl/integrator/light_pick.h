@@ -1,0 +1,98 @@
+// Stage: light_pick, one split-queue item (DESIGN §4). The adaptive splitting of Conty Estevez &
+// Kulla 2018 (Alg. 3) runs as passes over a queue instead of recursion: an item whose cluster
+// should split stages its children for the next pass (a split leaf takes each of its emitters with
+// probability 1); any other item picks one light below it stochastically (Alg. 2), samples a point
+// on it and stages a shadow work item carrying the unoccluded, MIS-weighted contribution divided by
+// the pick probability. Samplers without splitting (uniform, power, tree) see only the root item.
+#ifndef CANOPY_INTEGRATOR_LIGHT_PICK_H
+#define CANOPY_INTEGRATOR_LIGHT_PICK_H
+
+#include "../light_sample.h"
+#include "../shading.h"
+#include "light_sampler.h"
+#include "path_state.h"
+
+// Samples a point on `light` (chosen with probability pmf) from the path's shading point and, if
+// it can contribute, writes the shadow item. Returns 1 if an item was written.
+INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                                  const PathBuffers* pb, int path, int light, float pmf,
+                                  LtRng* rng, GLOBAL ShadowItem* out) {
+  float3 P = xyz_of(pb->shade_P[path]);
+  float3 N = xyz_of(pb->shade_N[path]);
+  float4 f = pb->shade_f[path];
+  float u1 = lt_rng_next(rng);
+  float u2 = lt_rng_next(rng);
+  LightSample s = sample_light(&ls->lights[light], P, u1, u2);
+  float cos_n = dot(N, s.wi);
+  if (!(s.pdf > 0.0f) || !(cos_n > 0.0f) || !(max3(s.Li) > 0.0f) || !(pmf > 0.0f)) return 0;
+  // MIS against BSDF sampling when the path continues with it (never for delta lights).
+  float w = 1.0f;
+  if (!s.is_delta && f.w > 0.0f) w = power_heuristic(pmf * s.pdf, cos_n * CANOPY_INV_PI);
+  float3 c = xyz_of(f) * s.Li * (cos_n * w / (s.pdf * pmf));
+  if (!is_finite_f(c.x + c.y + c.z) || !(max3(c) > 0.0f)) return 0;
+  float3 origin = offset_ray_origin(P, N, sc->ray_eps);
+  float3 to = P + s.wi * s.dist - origin;
+  float dist = length(to);
+  if (!(dist > 0.0f)) return 0;
+  ShadowItem item;
+  item.origin = f4_from3(origin, fmax(dist - 2.0f * sc->ray_eps, 0.0f));
+  item.dir = f4_from3(to / dist, uint_as_float_((uint)path));
+  item.contribution = f4_from3(c, 0.0f);
+  *out = item;
+  return 1;
+}
+
+// Processes one split item. Stages up to 4 child items in children[0..3] or up to 4 shadow items
+// in shadows[0..3]. Returns (children staged, shadow items staged, lights in the cut, 0).
+INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const SceneBuffers* sc,
+                            const PathBuffers* pb, GLOBAL SplitItem* children,
+                            GLOBAL ShadowItem* shadows) {
+  int4 out = make_int4(0, 0, 0, 0);
+  int path = it.path;
+  float3 P = xyz_of(pb->shade_P[path]);
+  float3 N = xyz_of(pb->shade_N[path]);
+  uint seed = float_as_uint_(pb->shade_N[path].w);
+  const LtTree* t = &ls->tree;
+
+  if (light_sampler_splits(ls) &&
+      lt_item_splits(t, it.sphere, it.cv2, it.code, it.budget, P, ls->threshold)) {
+    float4 imp = lt_code_importance(t, it.code, P, N);
+    if (it.code >= 0) { // interior node: its contributing lanes go to the next pass
+      int4 ch = t->children[it.code];
+      uint budget = it.budget / (uint)lt_code_lanes(t, it.code);
+      for (int lane = 0; lane < 4; ++lane) {
+        int code = i4_get(ch, lane);
+        if (code == LT_EMPTY || !(f4_get(imp, lane) > 0.0f)) continue;
+        SplitItem c;
+        c.sphere = lt_lane_sphere(t, it.code, lane);
+        c.path = path;
+        c.code = code;
+        c.budget = budget;
+        c.cv2 = lt_lane_cv2(t, it.code, lane);
+        children[out.x++] = c;
+      }
+      return out;
+    }
+    // Leaf: every contributing emitter is in the cut with probability 1.
+    int first = lt_leaf_first(it.code);
+    for (int j = 0; j < lt_leaf_count(it.code); ++j) {
+      if (!(f4_get(imp, j) > 0.0f)) continue;
+      int light = t->leaf_lights[first + j];
+      LtRng rng = lt_rng_make(seed, 0x80000000u ^ (uint)light);
+      out.z += 1;
+      out.y += light_pick_shadow_item(ls, sc, pb, path, light, 1.0f, &rng, &shadows[out.y]);
+    }
+    return out;
+  }
+
+  // One stochastic pick below the item (codes are unique within a cut: one stream each).
+  LtRng rng = lt_rng_make(seed, (uint)it.code);
+  float u = lt_rng_next(&rng);
+  float pmf;
+  int light = light_sampler_pick(ls, it.code, P, N, u, &rng, &pmf);
+  out.z = 1;
+  if (light >= 0) out.y = light_pick_shadow_item(ls, sc, pb, path, light, pmf, &rng, &shadows[0]);
+  return out;
+}
+
+#endif // CANOPY_INTEGRATOR_LIGHT_PICK_H

@@ -1,0 +1,71 @@
+// The light-selection techniques behind one interface, shared by the light_pick/shade_surface
+// kernels and the host reference: uniform, power (alias table), tree (Conty Estevez & Kulla 2018
+// Alg. 2), tree with adaptive splitting (Alg. 3) and exhaustive (every light; the reference).
+#ifndef CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
+#define CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
+
+#include "../light_tree_math.h"
+#include "../types.h"
+
+typedef struct LightSamplerCtx {
+  int kind; // SAMPLER_*
+  int light_count;
+  GLOBAL const Light* lights;
+  GLOBAL const float* power_pmf;   // power: probability of each light
+  GLOBAL const float* alias_prob;  // power: alias table (Walker/Vose)
+  GLOBAL const int* alias_index;
+  LtTree tree;                     // tree, tree-split, exhaustive
+  float threshold;                 // tree-split: split while the measure is below it (>= 1: always)
+  uint max_cut;                    // tree-split: cut size cap per shading point
+} LightSamplerCtx;
+
+// The split-queue root item of a shading point.
+INLINE SplitItem light_sampler_root(const LightSamplerCtx* ls, int path) {
+  SplitItem it;
+  it.sphere = ls->tree.root_sphere;
+  it.path = path;
+  it.code = 0;
+  it.budget = ls->max_cut;
+  it.cv2 = ls->tree.root_info.x;
+  return it;
+}
+
+// Picks one light among all of them (uniform, power) or below `code` (tree) with the random
+// numbers u (and rng, for the tree's xi refresh). Returns the light or -1; *pmf its probability.
+INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, float3 N, float u,
+                              LtRng* rng, float* pmf) {
+  *pmf = 0.0f;
+  if (ls->light_count <= 0) return -1;
+  if (ls->kind == SAMPLER_UNIFORM) {
+    int l = min((int)(u * (float)ls->light_count), ls->light_count - 1);
+    *pmf = 1.0f / (float)ls->light_count;
+    return l;
+  }
+  if (ls->kind == SAMPLER_POWER) {
+    float x = u * (float)ls->light_count;
+    int slot = min((int)x, ls->light_count - 1);
+    float frac = x - (float)slot;
+    int l = frac < ls->alias_prob[slot] ? slot : ls->alias_index[slot];
+    *pmf = ls->power_pmf[l];
+    return *pmf > 0.0f ? l : -1;
+  }
+  return lt_pick_below(&ls->tree, code, P, N, u, rng, LT_XI_RES_LIMIT, pmf);
+}
+
+// Probability that the technique produces `light` at (P, N): for MIS when a BSDF ray hits it.
+// With splitting it is the product of the lane probabilities below the item where splitting
+// stopped (DESIGN §4), recomputed along the light's bit-trail with the same functions.
+INLINE float light_sampler_pmf(const LightSamplerCtx* ls, float3 P, float3 N, int light) {
+  if (ls->light_count <= 0) return 0.0f;
+  if (ls->kind == SAMPLER_UNIFORM) return 1.0f / (float)ls->light_count;
+  if (ls->kind == SAMPLER_POWER) return ls->power_pmf[light];
+  if (ls->kind == SAMPLER_TREE)
+    return lt_pmf_below(&ls->tree, 0, P, N, ls->tree.trails[light]);
+  return lt_pmf_split(&ls->tree, P, N, light, ls->threshold, ls->max_cut);
+}
+
+INLINE int light_sampler_splits(const LightSamplerCtx* ls) {
+  return ls->kind == SAMPLER_TREE_SPLIT || ls->kind == SAMPLER_EXHAUSTIVE;
+}
+
+#endif // CANOPY_INTEGRATOR_LIGHT_SAMPLER_H

@@ -1,0 +1,31 @@
+// Per-path state of the wavefront (struct of arrays, indexed by path id) and the scene buffers, as
+// structs of pointers so the per-item stage functions take them in one argument on both the device
+// (where the kernels assemble them from their arguments, see cl/kernels/params.h) and the host.
+#ifndef CANOPY_INTEGRATOR_PATH_STATE_H
+#define CANOPY_INTEGRATOR_PATH_STATE_H
+
+#include "../types.h"
+
+typedef struct PathBuffers {
+  GLOBAL float4* ray_o;      // xyz: origin, w: tmin
+  GLOBAL float4* ray_d;      // xyz: unit direction
+  GLOBAL float4* throughput; // xyz: path throughput beta
+  GLOBAL float4* radiance;   // xyz: radiance gathered so far
+  GLOBAL uint* rng;          // PCG state (cl/rng.h)
+  GLOBAL Hit* hits;          // closest hit of the current ray
+  // The last shading point, kept for light picking in this bounce and for MIS at the next hit.
+  GLOBAL float4* shade_P; // xyz: position, w: solid-angle pdf of the BSDF direction that left it
+  GLOBAL float4* shade_N; // xyz: normal facing the incoming ray, w: light-pick seed (uint bits)
+  GLOBAL float4* shade_f; // xyz: beta * BSDF value (diffuse: albedo/pi), w: 1 if BSDF sampling
+                          // continues the path (MIS on), 0 at the last vertex (light sampling alone)
+} PathBuffers;
+
+typedef struct SceneBuffers {
+  GLOBAL const BvhNode* nodes;
+  GLOBAL const int* prim_index;
+  GLOBAL const Primitive* prims;
+  GLOBAL const Material* materials;
+  float ray_eps; // ray origin offset, see cl/shading.h
+} SceneBuffers;
+
+#endif // CANOPY_INTEGRATOR_PATH_STATE_H

@@ -1,0 +1,57 @@
+#include "render/features.h"
+
+#include "types.h"
+
+#include <fmt/format.h>
+
+namespace canopy {
+
+namespace {
+const char* kSamplerNames[] = {"uniform", "power", "tree", "tree-split", "exhaustive"};
+}
+
+int light_sampler_from_name(const std::string& name) {
+  for (int k = 0; k < 5; ++k)
+    if (name == kSamplerNames[k]) return k;
+  throw SceneError(fmt::format("light sampler '{}': unknown (uniform, power, tree, tree-split, "
+                               "exhaustive)",
+                               name));
+}
+
+const char* light_sampler_name(int kind) {
+  return kind >= 0 && kind < 5 ? kSamplerNames[kind] : "?";
+}
+
+KernelFeatures KernelFeatures::all(int light_sampler) {
+  KernelFeatures f;
+  f.light_point = f.light_spot = f.light_sphere = f.light_quad = f.light_triangle = true;
+  f.prim_sphere = true;
+  f.light_sampler = light_sampler;
+  return f;
+}
+
+std::string KernelFeatures::build_options() const {
+  return fmt::format("-DCANOPY_FEATURES_SET -DHAS_LIGHT_POINT={} -DHAS_LIGHT_SPOT={} "
+                     "-DHAS_LIGHT_SPHERE={} -DHAS_LIGHT_QUAD={} -DHAS_LIGHT_TRIANGLE={} "
+                     "-DHAS_PRIM_SPHERE={} -DCANOPY_LIGHT_SAMPLER={}",
+                     int(light_point), int(light_spot), int(light_sphere), int(light_quad),
+                     int(light_triangle), int(prim_sphere), light_sampler);
+}
+
+KernelFeatures scene_features(const Scene& scene, int light_sampler) {
+  KernelFeatures f;
+  f.light_sampler = light_sampler;
+  for (const Light& l : scene.lights) {
+    switch (l.type) {
+    case LIGHT_POINT: f.light_point = true; break;
+    case LIGHT_SPOT: f.light_spot = true; break;
+    case LIGHT_SPHERE: f.light_sphere = f.prim_sphere = true; break;
+    case LIGHT_QUAD: f.light_quad = true; break;
+    case LIGHT_TRIANGLE: f.light_triangle = true; break;
+    default: break;
+    }
+  }
+  return f;
+}
+
+} // namespace canopy

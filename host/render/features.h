@@ -1,0 +1,28 @@
+// Which kernel features a scene needs (DESIGN §7): light types, sphere primitives, the light
+// sampler. They become -D options so a kernel holds only the code the scene uses.
+#pragma once
+
+#include "scene/scene.h"
+
+#include <string>
+
+namespace canopy {
+
+struct KernelFeatures {
+  bool light_point = false, light_spot = false, light_sphere = false, light_quad = false,
+       light_triangle = false;
+  bool prim_sphere = false;
+  int light_sampler = 0; // SAMPLER_* (cl/types.h)
+
+  // Everything on (for the test that checks specialisation changes nothing).
+  static KernelFeatures all(int light_sampler);
+  std::string build_options() const;
+};
+
+// Throws SceneError for an unknown sampler name.
+int light_sampler_from_name(const std::string& name);
+const char* light_sampler_name(int kind);
+
+KernelFeatures scene_features(const Scene& scene, int light_sampler);
+
+} // namespace canopy

@@ -1,0 +1,62 @@
+#include "render/stats_report.h"
+
+#include <fmt/format.h>
+
+namespace canopy {
+
+nlohmann::json stats_to_json(const RenderStats& s, const RunTimings& run) {
+  nlohmann::json j;
+  j["wall_seconds"] = {{"total", run.total_seconds},
+                       {"load", run.load_seconds},
+                       {"build", s.build_seconds},
+                       {"light_tree_build", s.light_tree_seconds},
+                       {"upload", s.upload_seconds},
+                       {"compile", s.compile_seconds},
+                       {"render", s.render_seconds}};
+  j["samples"] = s.samples;
+  j["shading_points"] = s.shading_points;
+  j["shadow_rays"] = s.shadow_rays;
+  j["shadow_rays_per_shading_point"] =
+      s.shading_points ? double(s.shadow_rays) / double(s.shading_points) : 0.0;
+  j["nonfinite_samples"] = s.nonfinite_samples;
+  j["kernel_options"] = s.kernel_options;
+  nlohmann::json stages = nlohmann::json::object();
+  for (const auto& [name, st] : s.stages)
+    stages[name] = {{"seconds", st.seconds},
+                    {"items", st.items},
+                    {"launches", st.launches},
+                    {"items_per_second", st.seconds > 0.0 ? double(st.items) / st.seconds : 0.0}};
+  j["stages"] = stages;
+  nlohmann::json hist = nlohmann::json::array();
+  for (uint64_t c : s.cut_size_histogram) hist.push_back(c);
+  j["cut_size_histogram"] = hist; // index k: shading points whose light cut had k shadow items
+                                  // (last bin: that many or more)
+  return j;
+}
+
+std::string stats_to_table(const RenderStats& s, const RunTimings& run) {
+  std::string out;
+  out += fmt::format("time: total {:.3f} s = load {:.3f} + build {:.3f} (light tree {:.3f}) + upload "
+                     "{:.3f} + compile {:.3f} + render {:.3f}\n",
+                     run.total_seconds, run.load_seconds, s.build_seconds, s.light_tree_seconds,
+                     s.upload_seconds, s.compile_seconds, s.render_seconds);
+  out += fmt::format("{:<20} {:>10} {:>14} {:>10} {:>14}\n", "stage", "seconds", "items",
+                     "launches", "items/s");
+  for (const auto& [name, st] : s.stages)
+    out += fmt::format("{:<20} {:>10.4f} {:>14} {:>10} {:>14.4g}\n", name, st.seconds, st.items,
+                       st.launches, st.seconds > 0.0 ? double(st.items) / st.seconds : 0.0);
+  out += fmt::format("samples {}, shading points {}, shadow rays {} ({:.3f} per shading point), "
+                     "non-finite samples {}\n",
+                     s.samples, s.shading_points, s.shadow_rays,
+                     s.shading_points ? double(s.shadow_rays) / double(s.shading_points) : 0.0,
+                     s.nonfinite_samples);
+  out += "cut sizes:";
+  for (size_t k = 0; k < s.cut_size_histogram.size(); ++k)
+    if (s.cut_size_histogram[k])
+      out += fmt::format(" {}{}:{}", k, k + 1 == s.cut_size_histogram.size() ? "+" : "",
+                         s.cut_size_histogram[k]);
+  out += "\n";
+  return out;
+}
+
+} // namespace canopy
