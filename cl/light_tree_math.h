@@ -1,7 +1,7 @@
 // Light tree math shared by the host reference (C++20) and the OpenCL kernels (OpenCL C 1.2):
 // Conty Estevez & Kulla 2018, "Importance Sampling of Many Lights with Adaptive Tree Splitting".
-// See docs/DESIGN.md sections 2-4. Everything below the helper layer is written once and compiles as
-// both languages, so sampling on the host and on the device make the very same decisions.
+// See docs/DESIGN.md sections 2-4. Everything below the helper layer is written once and compiles
+// as both languages, so sampling on the host and on the device make the very same decisions.
 //
 // ---------------------------------------------------------------- device layout of the tree
 // The tree is 4-wide. Node `n` owns LT_NODE_F4 consecutive float4 in `nodes` (struct of arrays:
@@ -19,11 +19,11 @@
 //                       LT_EMPTY: unused lane (its energy is 0)
 //                       other < 0: leaf, code = -1 - child = (first << 2) | (count - 1): the
 //                       emitters leaf_lights[first .. first+count), count in 1..4
-// Node 0 is the root. Leaf emitters are not stored in the tree: their bounds are recomputed from the
-// `Light` records (lt_light_bounds) when a leaf is evaluated, so the tree costs ~40 bytes/emitter.
-// trails[light]: the light's bit-trail, 2 bits per 4-wide level starting with the root in the two
-// lowest bits, then 2 bits for its index inside its leaf.
-// root_sphere / root_info: bounding sphere of all emitters; (cv2, total energy, 0, 0).
+// Node 0 is the root. Leaf emitters are not stored in the tree: their bounds are recomputed from
+// the `Light` records (lt_light_bounds) when a leaf is evaluated, so the tree costs ~40
+// bytes/emitter. trails[light]: the light's bit-trail, 2 bits per 4-wide level starting with the
+// root in the two lowest bits, then 2 bits for its index inside its leaf. root_sphere / root_info:
+// bounding sphere of all emitters; (cv2, total energy, 0, 0).
 #ifndef CANOPY_LIGHT_TREE_MATH_H
 #define CANOPY_LIGHT_TREE_MATH_H
 
@@ -50,9 +50,9 @@
 // Smallest importance given to a lane that can contribute, so underflow never makes it 0 (the
 // importances of the four lanes are normalised by their maximum energy and minimum distance first).
 #define LT_IMPORTANCE_FLOOR 1e-30f
-// xi starts with 24 random bits. After choosing a lane of probability p its resolution is divided by
-// p; when fewer than LT_XI_MIN_BITS remain it is replaced by a fresh number from the rng stream.
-#define LT_XI_RES0 5.9604645e-08f     /* 2^-24 */
+// xi starts with 24 random bits. After choosing a lane of probability p its resolution is divided
+// by p; when fewer than LT_XI_MIN_BITS remain it is replaced by a fresh number from the rng stream.
+#define LT_XI_RES0 5.9604645e-08f      /* 2^-24 */
 #define LT_XI_RES_LIMIT 1.5258789e-05f /* 2^-16: refresh below 16 bits */
 #define LT_ONE_MINUS_EPS 0.99999994f   /* largest float below 1 */
 // Cone unions are padded by this angle (radians) so rounding never uncovers an input.
@@ -82,27 +82,49 @@ typedef int4 lt_mask4;
 #if defined(__SSE2__)
 #include <emmintrin.h>
 typedef __m128 lt_mask4;
-INLINE __m128 lt_ps_(float4 a) { return _mm_load_ps(&a.x); }
+INLINE __m128 lt_ps_(float4 a) {
+  return _mm_load_ps(&a.x);
+}
 INLINE float4 lt_f4_(__m128 v) {
   float4 r;
   _mm_store_ps(&r.x, v);
   return r;
 }
-INLINE float4 lt_splat4(float s) { return make_float4(s, s, s, s); }
-INLINE float4 lt_sqrt4(float4 a) { return lt_f4_(_mm_sqrt_ps(lt_ps_(a))); }
-INLINE float4 lt_min4(float4 a, float4 b) { return lt_f4_(_mm_min_ps(lt_ps_(a), lt_ps_(b))); }
-INLINE float4 lt_max4(float4 a, float4 b) { return lt_f4_(_mm_max_ps(lt_ps_(a), lt_ps_(b))); }
-INLINE lt_mask4 lt_lt4(float4 a, float4 b) { return _mm_cmplt_ps(lt_ps_(a), lt_ps_(b)); }
-INLINE lt_mask4 lt_le4(float4 a, float4 b) { return _mm_cmple_ps(lt_ps_(a), lt_ps_(b)); }
-INLINE lt_mask4 lt_gt4(float4 a, float4 b) { return _mm_cmpgt_ps(lt_ps_(a), lt_ps_(b)); }
-INLINE lt_mask4 lt_ge4(float4 a, float4 b) { return _mm_cmpge_ps(lt_ps_(a), lt_ps_(b)); }
-INLINE lt_mask4 lt_and4(lt_mask4 a, lt_mask4 b) { return _mm_and_ps(a, b); }
+INLINE float4 lt_splat4(float s) {
+  return make_float4(s, s, s, s);
+}
+INLINE float4 lt_sqrt4(float4 a) {
+  return lt_f4_(_mm_sqrt_ps(lt_ps_(a)));
+}
+INLINE float4 lt_min4(float4 a, float4 b) {
+  return lt_f4_(_mm_min_ps(lt_ps_(a), lt_ps_(b)));
+}
+INLINE float4 lt_max4(float4 a, float4 b) {
+  return lt_f4_(_mm_max_ps(lt_ps_(a), lt_ps_(b)));
+}
+INLINE lt_mask4 lt_lt4(float4 a, float4 b) {
+  return _mm_cmplt_ps(lt_ps_(a), lt_ps_(b));
+}
+INLINE lt_mask4 lt_le4(float4 a, float4 b) {
+  return _mm_cmple_ps(lt_ps_(a), lt_ps_(b));
+}
+INLINE lt_mask4 lt_gt4(float4 a, float4 b) {
+  return _mm_cmpgt_ps(lt_ps_(a), lt_ps_(b));
+}
+INLINE lt_mask4 lt_ge4(float4 a, float4 b) {
+  return _mm_cmpge_ps(lt_ps_(a), lt_ps_(b));
+}
+INLINE lt_mask4 lt_and4(lt_mask4 a, lt_mask4 b) {
+  return _mm_and_ps(a, b);
+}
 INLINE float4 lt_sel4(float4 a, float4 b, lt_mask4 m) {
   return lt_f4_(_mm_or_ps(_mm_and_ps(m, lt_ps_(b)), _mm_andnot_ps(m, lt_ps_(a))));
 }
 #else
 typedef int4 lt_mask4;
-INLINE float4 lt_splat4(float s) { return make_float4(s, s, s, s); }
+INLINE float4 lt_splat4(float s) {
+  return make_float4(s, s, s, s);
+}
 INLINE float4 lt_sqrt4(float4 a) {
   return make_float4(std::sqrt(a.x), std::sqrt(a.y), std::sqrt(a.z), std::sqrt(a.w));
 }
@@ -120,8 +142,12 @@ INLINE lt_mask4 lt_lt4(float4 a, float4 b) {
 INLINE lt_mask4 lt_le4(float4 a, float4 b) {
   return make_int4(-(a.x <= b.x), -(a.y <= b.y), -(a.z <= b.z), -(a.w <= b.w));
 }
-INLINE lt_mask4 lt_gt4(float4 a, float4 b) { return lt_lt4(b, a); }
-INLINE lt_mask4 lt_ge4(float4 a, float4 b) { return lt_le4(b, a); }
+INLINE lt_mask4 lt_gt4(float4 a, float4 b) {
+  return lt_lt4(b, a);
+}
+INLINE lt_mask4 lt_ge4(float4 a, float4 b) {
+  return lt_le4(b, a);
+}
 INLINE lt_mask4 lt_and4(lt_mask4 a, lt_mask4 b) {
   return make_int4(a.x & b.x, a.y & b.y, a.z & b.z, a.w & b.w);
 }
@@ -129,8 +155,12 @@ INLINE float4 lt_sel4(float4 a, float4 b, lt_mask4 m) {
   return make_float4(m.x ? b.x : a.x, m.y ? b.y : a.y, m.z ? b.z : a.z, m.w ? b.w : a.w);
 }
 #endif
-INLINE float lt_minf(float a, float b) { return b < a ? b : a; }
-INLINE float lt_maxf(float a, float b) { return a < b ? b : a; }
+INLINE float lt_minf(float a, float b) {
+  return b < a ? b : a;
+}
+INLINE float lt_maxf(float a, float b) {
+  return a < b ? b : a;
+}
 #if defined(__GNUC__)
 #define LT_HOT inline __attribute__((always_inline))
 #define LT_PREFETCH(addr) __builtin_prefetch(addr)
@@ -146,13 +176,23 @@ INLINE float3 lt_min3(float3 a, float3 b) {
 INLINE float3 lt_max3(float3 a, float3 b) {
   return make_float3(lt_maxf(a.x, b.x), lt_maxf(a.y, b.y), lt_maxf(a.z, b.z));
 }
-INLINE float lt_clampf(float x, float lo, float hi) { return lt_minf(lt_maxf(x, lo), hi); }
+INLINE float lt_clampf(float x, float lo, float hi) {
+  return lt_minf(lt_maxf(x, lo), hi);
+}
 
-INLINE float4 lt_add4s(float4 a, float s) { return a + lt_splat4(s); }
-INLINE float lt_hmin4(float4 a) { return lt_minf(lt_minf(a.x, a.y), lt_minf(a.z, a.w)); }
-INLINE float lt_hmax4(float4 a) { return lt_maxf(lt_maxf(a.x, a.y), lt_maxf(a.z, a.w)); }
+INLINE float4 lt_add4s(float4 a, float s) {
+  return a + lt_splat4(s);
+}
+INLINE float lt_hmin4(float4 a) {
+  return lt_minf(lt_minf(a.x, a.y), lt_minf(a.z, a.w));
+}
+INLINE float lt_hmax4(float4 a) {
+  return lt_maxf(lt_maxf(a.x, a.y), lt_maxf(a.z, a.w));
+}
 // The one summation order used for the four lanes everywhere (sampling and pmf must agree).
-INLINE float lt_sum4(float4 a) { return (a.x + a.y) + (a.z + a.w); }
+INLINE float lt_sum4(float4 a) {
+  return (a.x + a.y) + (a.z + a.w);
+}
 
 // ---------------------------------------------------------------- random numbers
 // A counter-based stream: value i of stream (seed, stream) is a hash of (key, i). Cheap to carry
@@ -183,7 +223,9 @@ INLINE uint lt_rng_next_u32(LtRng* r) {
   return x;
 }
 // Uniform in [0, 1) with 24 random bits.
-INLINE float lt_rng_next(LtRng* r) { return (float)(lt_rng_next_u32(r) >> 8) * LT_XI_RES0; }
+INLINE float lt_rng_next(LtRng* r) {
+  return (float)(lt_rng_next_u32(r) >> 8) * LT_XI_RES0;
+}
 
 // ---------------------------------------------------------------- orientation cones (Alg. 1)
 typedef struct LtCone {
@@ -200,7 +242,9 @@ INLINE LtCone lt_make_cone(float3 axis, float theta_o, float theta_e) {
   return c;
 }
 // Angle between unit vectors, accurate near 0 and pi (unlike acos of the dot product).
-INLINE float lt_angle_between(float3 a, float3 b) { return atan2(length(cross(a, b)), dot(a, b)); }
+INLINE float lt_angle_between(float3 a, float3 b) {
+  return atan2(length(cross(a, b)), dot(a, b));
+}
 // Rodrigues rotation of v about the unit axis k.
 INLINE float3 lt_rotate(float3 v, float3 k, float angle) {
   float c = cos(angle);
@@ -258,7 +302,9 @@ INLINE float lt_m_omega(float theta_o, float theta_e) {
 // ---------------------------------------------------------------- geometric term statistics (§5.4)
 // Distance to an emitter uniform in [a, b], g = 1/x^2. Eq. 8-9 in the cancellation-free form:
 // E[g] = 1/(ab), V[g] = (b-a)^2 / (3 a^3 b^3) (written to avoid overflowing a^3 b^3).
-INLINE float lt_geom_mean(float a, float b) { return 1.0f / (a * b); }
+INLINE float lt_geom_mean(float a, float b) {
+  return 1.0f / (a * b);
+}
 INLINE float lt_geom_var(float a, float b) {
   float q = (b - a) / (a * b);
   return q * q / (3.0f * a * b);
@@ -284,10 +330,12 @@ INLINE float lt_split_sigma2_paper(float var_e, float mean_e, float a, float b) 
 //
 // Threshold calibration: split while measure < threshold, i.e. sigma > threshold^-4 - 1. The
 // default 0.85 (the paper's) means sigma > 1.914: for equal-energy emitters, P closer than 1.17 r
-// to the cluster centre; for a distant cluster, energy CV > 1.9. On the spiral benchmark scene
-// (10^4 point lights over objects, bench/bench_light_tree.cpp, SplitCut) this gives small cuts near
-// the lights and single picks far away, which is the behaviour of the paper's Fig. 11; threshold 1
-// splits down to every light (capped by max_cut), 0 never splits.
+// to the cluster centre; for a distant cluster, energy CV > 1.9. P inside a cluster's sphere always
+// splits it (a = 0), so points among the lights get cuts of tens of clusters and distant points a
+// single pick, the behaviour of the paper's Fig. 11. Measured mean cut on the spiral scene (10^4
+// point lights, shading points on the ground below, bench SplitCut): threshold 0: 1, 0.5: 19,
+// 0.85: 38, 0.95: 213, 1: every light (capped by max_cut). 0.85 is kept as the default: it splits
+// where the importance is least reliable (near and inside clusters) at a moderate cut size.
 INLINE float lt_split_measure(float3 P, float4 sphere, float cv2_e) {
   float3 d3 = xyz_of(sphere) - P;
   float d2 = dot(d3, d3);
@@ -382,7 +430,8 @@ INLINE float4 lt_sphere_of_box(float3 bmin, float3 bmax) {
 // sin a sin b (no acos). Emitters below the horizon of N are culled (opaque surfaces).
 // Lanes are normalised by the largest energy and the smallest clamped d^2 among the lanes (only
 // ratios matter) and a lane that can contribute gets at least LT_IMPORTANCE_FLOOR: the result is
-// never 0 for a cluster that can contribute and never overflows.
+// never 0 for a cluster that can contribute and never overflows. If no lane can contribute, lanes
+// with energy get E/d^2 (see below); only lanes without energy are ever 0 then.
 LT_HOT float4 lt_importance4(float4 cx, float4 cy, float4 cz, float4 r, float4 ax, float4 ay,
                              float4 az, float4 cos_o, float4 cos_e, float4 energy, float3 P,
                              float3 N) {
@@ -432,25 +481,39 @@ LT_HOT float4 lt_importance4(float4 cx, float4 cy, float4 cz, float4 r, float4 a
   float4 oc = orient * cos_i;
   float4 imp = e * g * oc;
   lt_mask4 contributes = lt_and4(alive, lt_gt4(oc, zero));
-  return lt_sel4(zero, lt_max4(imp, lt_splat4(LT_IMPORTANCE_FLOOR)), contributes);
+  float4 res = lt_sel4(zero, lt_max4(imp, lt_splat4(LT_IMPORTANCE_FLOOR)), contributes);
+  // No lane can contribute but some has energy (bounds of the parent were looser than those of
+  // its children): rank by energy and distance alone, so a descent never dead-ends and the pmf
+  // sums to 1 over the lights with energy. Such picks contribute 0, which keeps them unbiased.
+  if (!(lt_sum4(res) > 0.0f) && emax > 0.0f)
+    res = lt_sel4(zero, lt_max4(e * g, lt_splat4(LT_IMPORTANCE_FLOOR)), alive);
+  return res;
 }
 
 // ---------------------------------------------------------------- tree traversal (Alg. 2)
 // A view of the tree buffers (kernel: build it from the kernel arguments in private memory).
 typedef struct LtTree {
-  GLOBAL const float4* nodes;      // LT_NODE_F4 per node
-  GLOBAL const int4* children;     // one per node
-  GLOBAL const int* leaf_lights;   // light indices in leaf order
-  GLOBAL const uint* trails;       // per light index
-  GLOBAL const Light* lights;      // the scene's lights
-  float4 root_sphere;              // bounding sphere of all emitters
-  float4 root_info;                // x: energy CV^2, y: total energy
+  GLOBAL const float4* nodes;    // LT_NODE_F4 per node
+  GLOBAL const int4* children;   // one per node
+  GLOBAL const int* leaf_lights; // light indices in leaf order
+  GLOBAL const uint* trails;     // per light index
+  GLOBAL const Light* lights;    // the scene's lights
+  float4 root_sphere;            // bounding sphere of all emitters
+  float4 root_info;              // x: energy CV^2, y: total energy
 } LtTree;
 
-INLINE int lt_is_leaf(int code) { return code < 0 && code != LT_EMPTY; }
-INLINE int lt_leaf_first(int code) { return (-1 - code) >> 2; }
-INLINE int lt_leaf_count(int code) { return ((-1 - code) & 3) + 1; }
-INLINE int lt_leaf_code(int first, int count) { return -1 - ((first << 2) | (count - 1)); }
+INLINE int lt_is_leaf(int code) {
+  return code < 0 && code != LT_EMPTY;
+}
+INLINE int lt_leaf_first(int code) {
+  return (-1 - code) >> 2;
+}
+INLINE int lt_leaf_count(int code) {
+  return ((-1 - code) & 3) + 1;
+}
+INLINE int lt_leaf_code(int first, int count) {
+  return -1 - ((first << 2) | (count - 1));
+}
 
 LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) {
   GLOBAL const float4* n = t->nodes + node * LT_NODE_F4;
@@ -464,7 +527,8 @@ LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) 
   int count = lt_leaf_count(code);
   float v[10][4];
   for (int j = 0; j < 4; ++j) {
-    for (int k = 0; k < 10; ++k) v[k][j] = 0.0f;
+    for (int k = 0; k < 10; ++k)
+      v[k][j] = 0.0f;
     if (j < count) {
       float3 bmin, bmax, axis;
       float co, ce, en;
@@ -511,10 +575,12 @@ LT_HOT int lt_choose_lane(float4 imp, float* xi) {
   float c1 = c0 + imp.y;
   float c2 = c1 + imp.z;
   int k = (target >= c0) + (target >= c1) + (target >= c2);
-  while (k > 0 && !(f4_get(imp, k) > 0.0f)) --k; // target rounded past the last lane
+  while (k > 0 && !(f4_get(imp, k) > 0.0f))
+    --k; // target rounded past the last lane
   float lo = k == 0 ? 0.0f : (k == 1 ? c0 : (k == 2 ? c1 : c2));
   if (!(f4_get(imp, k) > 0.0f)) { // only reachable when lane 0 is empty and target < c0 = 0
-    while (k < 3 && !(f4_get(imp, k) > 0.0f)) ++k;
+    while (k < 3 && !(f4_get(imp, k) > 0.0f))
+      ++k;
     lo = 0.0f;
   }
   *xi = lt_clampf((target - lo) / f4_get(imp, k), 0.0f, LT_ONE_MINUS_EPS);

@@ -56,8 +56,12 @@ private:
   cl::CommandQueue queue_;
 };
 
-// Launch helper: global size rounded up to a multiple of `local` (0 = let the runtime choose).
-cl::Event enqueue_1d(cl::CommandQueue& q, const cl::Kernel& k, size_t n, size_t local = 0);
+// Launch helper: global size rounded up to a multiple of `local`; kernels ignore the padding items
+// (`if (i >= count) return`). Keep `local` fixed: PoCL compiles a work-group function per local
+// size, and letting it choose one per launch size recompiles kernels in the middle of a render.
+constexpr size_t kDefaultLocalSize = 64;
+cl::Event enqueue_1d(cl::CommandQueue& q, const cl::Kernel& k, size_t n,
+                     size_t local = kDefaultLocalSize);
 
 // Nanoseconds between a finished event's start and end (profiling).
 double event_seconds(const cl::Event& e);

@@ -1,0 +1,563 @@
+#include "lighttree/light_tree.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+
+namespace canopy {
+namespace {
+
+constexpr float kPi = M_PI_F;
+constexpr float kHalfPi = 1.57079637f;                  // float(pi/2) == acosf(0)
+constexpr int kMaxBinaryDepth = 2 * LT_MAX_NODE_LEVELS; // leaves at binary depth <= 30
+constexpr int kMaxBins = 64;
+constexpr int kParallelBinning = 1 << 16;
+
+inline float3 vmin(float3 a, float3 b) {
+  return {b.x < a.x ? b.x : a.x, b.y < a.y ? b.y : a.y, b.z < a.z ? b.z : a.z};
+}
+inline float3 vmax(float3 a, float3 b) {
+  return {a.x < b.x ? b.x : a.x, a.y < b.y ? b.y : a.y, a.z < b.z ? b.z : a.z};
+}
+inline float comp(float3 v, int axis) {
+  return axis == 0 ? v.x : (axis == 1 ? v.y : v.z);
+}
+
+// A cone with cached cos/sin of theta_o for the cheap "already covered" test and M_Omega.
+struct HCone {
+  float3 axis{0, 0, 1};
+  float to = 0, te = 0, co = 1, so = 0;
+  bool empty = true;
+};
+inline HCone hcone(const LtCone& c) {
+  HCone h;
+  h.axis = c.axis;
+  h.to = c.theta_o;
+  h.te = c.theta_e;
+  h.co = c.theta_o >= kPi ? -1.0f : (c.theta_o == 0.0f ? 1.0f : std::cos(c.theta_o));
+  h.so = c.theta_o >= kPi || c.theta_o == 0.0f ? 0.0f : std::sin(c.theta_o);
+  h.empty = false;
+  return h;
+}
+inline LtCone ltcone(const HCone& h) {
+  return lt_make_cone(h.axis, h.to, h.te);
+}
+
+// Alg. 1 with fast paths for the common cases (one cone already covers the other).
+inline HCone hunion(const HCone& x, const HCone& y) {
+  if (y.empty) return x;
+  if (x.empty) return y;
+  const HCone& a = x.to >= y.to ? x : y;
+  const HCone& b = x.to >= y.to ? y : x;
+  float te = a.te < b.te ? b.te : a.te;
+  if (a.to >= kPi) {
+    HCone r = a;
+    r.te = te;
+    return r;
+  }
+  float cd = dot(a.axis, b.axis);
+  // covered iff theta_d <= to_a - to_b, i.e. cos(theta_d) >= cos(to_a - to_b); the margin keeps
+  // rounding of the cosines on the safe side.
+  if ((a.axis.x == b.axis.x && a.axis.y == b.axis.y && a.axis.z == b.axis.z) ||
+      cd >= a.co * b.co + a.so * b.so + 1e-6f) {
+    HCone r = a;
+    r.te = te;
+    return r;
+  }
+  return hcone(lt_cone_union(ltcone(a), ltcone(b)));
+}
+
+// M_Omega (Eq. 1) from cached cos/sin; the common theta_e = pi/2 needs no trigonometry:
+// to <= pi/2: 2pi - pi cos(to) + pi^2/2 sin(to); to > pi/2: 2pi(1 - cos to) + pi sin(to)(pi - to).
+inline float m_omega(const HCone& c) {
+  if (c.to >= kPi) return 4.0f * kPi;
+  if (c.te == kHalfPi) {
+    if (c.to <= kHalfPi) return 2.0f * kPi - kPi * c.co + 0.5f * kPi * kPi * c.so;
+    return 2.0f * kPi * (1.0f - c.co) + kPi * c.so * (kPi - c.to);
+  }
+  return lt_m_omega(c.to, c.te);
+}
+
+struct Prim {
+  float3 bmin, bmax, c;
+  HCone cone;
+  float e;
+  int id;
+};
+
+struct Acc {
+  float3 bmin{FLT_INF, FLT_INF, FLT_INF}, bmax{-FLT_INF, -FLT_INF, -FLT_INF};
+  float3 cmin{FLT_INF, FLT_INF, FLT_INF}, cmax{-FLT_INF, -FLT_INF, -FLT_INF};
+  HCone cone;
+  double e = 0, e2 = 0;
+  int count = 0;
+
+  void add(const Prim& p) {
+    bmin = vmin(bmin, p.bmin);
+    bmax = vmax(bmax, p.bmax);
+    cmin = vmin(cmin, p.c);
+    cmax = vmax(cmax, p.c);
+    cone = hunion(cone, p.cone);
+    e += p.e;
+    e2 += double(p.e) * double(p.e);
+    ++count;
+  }
+  void merge(const Acc& o) {
+    if (o.count == 0) return;
+    bmin = vmin(bmin, o.bmin);
+    bmax = vmax(bmax, o.bmax);
+    cmin = vmin(cmin, o.cmin);
+    cmax = vmax(cmax, o.cmax);
+    cone = hunion(cone, o.cone);
+    e += o.e;
+    e2 += o.e2;
+    count += o.count;
+  }
+};
+
+// Surface-area measure M_A with a guard for flat/degenerate boxes: the area plus a small multiple
+// (relative to the parent's size) of the edge lengths, so collinear emitters still compare.
+inline float area_measure(float3 bmin, float3 bmax, float delta) {
+  float3 d = vmax(bmax - bmin, make_float3(0, 0, 0));
+  return 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x) + delta * (d.x + d.y + d.z);
+}
+
+Acc reduce_range(const Prim* prims, int begin, int end) {
+  if (end - begin > kParallelBinning) {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<int>(begin, end, 1 << 14), Acc(),
+        [&](const tbb::blocked_range<int>& r, Acc a) {
+          for (int i = r.begin(); i != r.end(); ++i)
+            a.add(prims[i]);
+          return a;
+        },
+        [](Acc a, const Acc& b) {
+          a.merge(b);
+          return a;
+        });
+  }
+  Acc a;
+  for (int i = begin; i < end; ++i)
+    a.add(prims[i]);
+  return a;
+}
+
+// Bins of the three axes, nbins each (bins[axis * nbins + i]).
+struct BinSet {
+  int nbins = 0;
+  std::vector<Acc> bins;
+  explicit BinSet(int nb = 0) : nbins(nb), bins(3 * size_t(nb)) {}
+  Acc& at(int axis, int i) { return bins[size_t(axis) * nbins + i]; }
+  const Acc& at(int axis, int i) const { return bins[size_t(axis) * nbins + i]; }
+};
+
+struct BinMap {
+  float origin[3];
+  float scale[3];
+  bool active[3];
+  int nbins;
+  int index(float3 c, int axis) const {
+    int k = static_cast<int>((comp(c, axis) - origin[axis]) * scale[axis]);
+    return k < 0 ? 0 : (k >= nbins ? nbins - 1 : k);
+  }
+};
+
+class Builder {
+public:
+  Builder(std::vector<Prim>& prims, std::vector<BinaryLightNode>& nodes,
+          const LightTreeBuildOptions& opt)
+      : prims_(prims), nodes_(nodes), opt_(opt) {}
+
+  std::atomic<int> next{1};
+  std::atomic<int> max_depth{0};
+
+  void build(int ni, int begin, int end, int depth, const Acc& acc) {
+    BinaryLightNode& node = nodes_[ni];
+    const int n = end - begin;
+    node.bmin = acc.bmin;
+    node.bmax = acc.bmax;
+    node.cone = ltcone(acc.cone);
+    node.energy = acc.e;
+    node.energy2 = acc.e2;
+    node.count = n;
+    node.first = begin;
+    node.left = node.right = -1;
+
+    int d = max_depth.load(std::memory_order_relaxed);
+    while (depth > d && !max_depth.compare_exchange_weak(d, depth)) {
+    }
+    if (n <= 1 || n <= opt_.leaf_size || depth >= kMaxBinaryDepth) {
+      if (n > LT_MAX_LEAF) throw std::logic_error("light tree: leaf too large");
+      return;
+    }
+    // Child capacity at depth + 1 so every leaf ends at binary depth <= kMaxBinaryDepth.
+    const long long cap = 1LL << std::min(62, kMaxBinaryDepth + 1 - depth);
+
+    const double weight = acc.e > 0 ? acc.e : double(n);
+    int axis = -1, split_bin = -1;
+    Acc left_acc, right_acc;
+    double best = INFINITY;
+    float3 cext = acc.cmax - acc.cmin;
+    bool any_extent = cext.x > 0 || cext.y > 0 || cext.z > 0;
+    if (any_extent) {
+      BinMap map;
+      map.nbins = std::max(2, std::min({opt_.bins, kMaxBins, n}));
+      for (int a = 0; a < 3; ++a) {
+        float ext = comp(cext, a);
+        map.active[a] = ext > 0 && std::isfinite(ext);
+        map.origin[a] = comp(acc.cmin, a);
+        map.scale[a] = map.active[a] ? float(map.nbins) * (1.0f - 1e-6f) / ext : 0.0f;
+      }
+      BinSet bs = bin(begin, end, map);
+      float3 ext = acc.bmax - acc.bmin;
+      float lmax = std::max({ext.x, ext.y, ext.z});
+      float delta = 1e-3f * lmax;
+      double parent_measure = double(area_measure(acc.bmin, acc.bmax, delta)) * m_omega(acc.cone);
+      if (!(parent_measure > 0)) parent_measure = 1;
+      std::vector<Acc> prefix(map.nbins);
+      for (int a = 0; a < 3; ++a) {
+        float len = comp(ext, a);
+        if (!map.active[a] || !(len > 0)) continue; // zero-length axis: skip
+        double kr = double(lmax) / double(len);
+        prefix[0] = bs.at(a, 0);
+        for (int i = 1; i < map.nbins; ++i) {
+          prefix[i] = prefix[i - 1];
+          prefix[i].merge(bs.at(a, i));
+        }
+        Acc suffix;
+        for (int i = map.nbins - 1; i >= 1; --i) {
+          suffix.merge(bs.at(a, i));
+          const Acc& l = prefix[i - 1];
+          if (l.count == 0 || suffix.count == 0) continue;
+          double wl = acc.e > 0 ? l.e : double(l.count);
+          double wr = acc.e > 0 ? suffix.e : double(suffix.count);
+          double cost =
+              kr *
+              (wl * area_measure(l.bmin, l.bmax, delta) * m_omega(l.cone) +
+               wr * area_measure(suffix.bmin, suffix.bmax, delta) * m_omega(suffix.cone)) /
+              parent_measure;
+          if (cost < best) {
+            best = cost;
+            axis = a;
+            split_bin = i - 1;
+            left_acc = l;
+            right_acc = suffix;
+          }
+        }
+      }
+      if (n <= LT_MAX_LEAF && (axis < 0 || best >= weight)) return; // leaf cost E_c wins
+      if (axis >= 0 && (left_acc.count > cap || right_acc.count > cap)) axis = -1;
+      if (axis >= 0) {
+        Prim* mid = std::partition(prims_.data() + begin, prims_.data() + end, [&](const Prim& p) {
+          return map.index(p.c, axis) <= split_bin;
+        });
+        int m = static_cast<int>(mid - prims_.data());
+        if (m - begin != left_acc.count) throw std::logic_error("light tree: partition mismatch");
+        recurse(ni, begin, m, end, depth, left_acc, right_acc);
+        return;
+      }
+    } else if (n <= LT_MAX_LEAF) {
+      return; // coincident emitters: one leaf
+    }
+    // Fallback: median split (by index when all centroids coincide, else on the widest axis).
+    int m = begin + n / 2;
+    if (any_extent) {
+      int a = cext.x >= cext.y && cext.x >= cext.z ? 0 : (cext.y >= cext.z ? 1 : 2);
+      std::nth_element(prims_.data() + begin, prims_.data() + m, prims_.data() + end,
+                       [a](const Prim& p, const Prim& q) { return comp(p.c, a) < comp(q.c, a); });
+    }
+    Acc l, r;
+    if (n > kParallelBinning) {
+      tbb::parallel_invoke([&] { l = reduce_range(prims_.data(), begin, m); },
+                           [&] { r = reduce_range(prims_.data(), m, end); });
+    } else {
+      l = reduce_range(prims_.data(), begin, m);
+      r = reduce_range(prims_.data(), m, end);
+    }
+    recurse(ni, begin, m, end, depth, l, r);
+  }
+
+private:
+  void recurse(int ni, int begin, int mid, int end, int depth, const Acc& l, const Acc& r) {
+    int li = next.fetch_add(2);
+    nodes_[ni].left = li;
+    nodes_[ni].right = li + 1;
+    if (end - begin > opt_.parallel_grain) {
+      tbb::parallel_invoke([&] { build(li, begin, mid, depth + 1, l); },
+                           [&] { build(li + 1, mid, end, depth + 1, r); });
+    } else {
+      build(li, begin, mid, depth + 1, l);
+      build(li + 1, mid, end, depth + 1, r);
+    }
+  }
+
+  void bin_serial(const Prim* p, int begin, int end, const BinMap& map, BinSet& bs) const {
+    for (int a = 0; a < 3; ++a) {
+      if (!map.active[a]) continue;
+      for (int i = begin; i < end; ++i)
+        bs.at(a, map.index(p[i].c, a)).add(p[i]);
+    }
+  }
+
+  BinSet bin(int begin, int end, const BinMap& map) const {
+    const Prim* p = prims_.data();
+    if (end - begin > kParallelBinning) {
+      return tbb::parallel_reduce(
+          tbb::blocked_range<int>(begin, end, 1 << 14), BinSet(map.nbins),
+          [&](const tbb::blocked_range<int>& r, BinSet bs) {
+            bin_serial(p, r.begin(), r.end(), map, bs);
+            return bs;
+          },
+          [&](BinSet a, const BinSet& b) {
+            for (int ax = 0; ax < 3; ++ax)
+              for (int i = 0; i < map.nbins; ++i)
+                a.at(ax, i).merge(b.at(ax, i));
+            return a;
+          });
+    }
+    BinSet bs(map.nbins);
+    bin_serial(p, begin, end, map, bs);
+    return bs;
+  }
+
+  std::vector<Prim>& prims_;
+  std::vector<BinaryLightNode>& nodes_;
+  const LightTreeBuildOptions& opt_;
+};
+
+inline float cos_of_theta_o(float to) {
+  return to >= kPi ? -1.0f : (to <= 0.0f ? 1.0f : std::cos(to));
+}
+inline float cos_of_theta_e(float te) {
+  return te >= kHalfPi ? 0.0f : (te <= 0.0f ? 1.0f : std::cos(te));
+}
+
+} // namespace
+
+float BinaryLightNode::cv2() const {
+  if (!(energy > 0) || count <= 1) return 0.0f;
+  double v = double(count) * energy2 / (energy * energy) - 1.0;
+  return v > 0 ? static_cast<float>(v) : 0.0f;
+}
+
+EmitterBounds emitter_bounds(const Light& light) {
+  EmitterBounds b;
+  float3 axis;
+  float co, ce, e;
+  lt_light_bounds(&light, &b.bmin, &b.bmax, &axis, &co, &ce, &e);
+  float to = co >= 1.0f ? 0.0f : (co <= -1.0f ? kPi : std::acos(co));
+  float te = ce <= 0.0f ? kHalfPi : std::acos(ce);
+  b.cone = lt_make_cone(axis, to, te);
+  b.energy = e;
+  return b;
+}
+
+std::vector<EmitterBounds> emitter_bounds(const std::vector<Light>& lights) {
+  std::vector<EmitterBounds> out(lights.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, lights.size(), 4096),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i)
+                        out[i] = emitter_bounds(lights[i]);
+                    });
+  return out;
+}
+
+double saoh_cost(const BinaryLightNode& parent, const BinaryLightNode& left,
+                 const BinaryLightNode& right) {
+  float3 ext = parent.bmax - parent.bmin;
+  float delta = 1e-3f * std::max({ext.x, ext.y, ext.z});
+  auto measure = [&](const BinaryLightNode& n) {
+    return double(area_measure(n.bmin, n.bmax, delta)) * m_omega(hcone(n.cone));
+  };
+  return (left.energy * measure(left) + right.energy * measure(right)) / measure(parent);
+}
+
+BinaryLightTree build_binary_light_tree(const std::vector<EmitterBounds>& emitters,
+                                        const LightTreeBuildOptions& opt_in) {
+  LightTreeBuildOptions opt = opt_in;
+  opt.bins = std::clamp(opt.bins, 2, kMaxBins);
+  opt.leaf_size = std::clamp(opt.leaf_size, 1, LT_MAX_LEAF);
+  opt.parallel_grain = std::max(opt.parallel_grain, 64);
+  BinaryLightTree bt;
+  const int n = static_cast<int>(emitters.size());
+  if (n == 0) return bt;
+  if (static_cast<long long>(n) >= (1LL << 28))
+    throw std::invalid_argument("light tree: too many lights");
+
+  std::vector<Prim> prims(n);
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i != r.end(); ++i) {
+      const EmitterBounds& e = emitters[i];
+      Prim& p = prims[i];
+      p.bmin = e.bmin;
+      p.bmax = e.bmax;
+      p.c = (e.bmin + e.bmax) * 0.5f;
+      p.cone = hcone(e.cone);
+      p.e = e.energy;
+      p.id = i;
+    }
+  });
+  bt.nodes.resize(2 * static_cast<size_t>(n));
+  Builder b(prims, bt.nodes, opt);
+  Acc root = reduce_range(prims.data(), 0, n);
+  b.build(0, 0, n, 0, root);
+  bt.nodes.resize(b.next.load());
+  bt.depth = b.max_depth.load();
+  bt.order.resize(n);
+  for (int i = 0; i < n; ++i)
+    bt.order[i] = prims[i].id;
+  return bt;
+}
+
+size_t LightTree::device_bytes() const {
+  return nodes.size() * sizeof(float4) + children.size() * sizeof(int4) +
+         leaf_lights.size() * sizeof(int) + trails.size() * sizeof(uint32_t) + 2 * sizeof(float4);
+}
+
+LtTree LightTree::view(const Light* lights) const {
+  LtTree t;
+  t.nodes = nodes.data();
+  t.children = children.data();
+  t.leaf_lights = leaf_lights.data();
+  t.trails = trails.data();
+  t.lights = lights;
+  t.root_sphere = root_sphere;
+  t.root_info = root_info;
+  return t;
+}
+
+namespace {
+inline void set_lane_value(float4& v, int lane, float x) {
+  (lane == 0 ? v.x : lane == 1 ? v.y : lane == 2 ? v.z : v.w) = x;
+}
+
+// Greedy collapse fills every node with four lanes when it can (fewer levels); pairwise collapse
+// (each level = two binary levels) is the fallback that always fits the bit-trail budget, since the
+// builder keeps leaves at binary depth <= 2 * LT_MAX_NODE_LEVELS.
+struct TooDeep {};
+struct Collapser {
+  const BinaryLightTree& bt;
+  LightTree& t;
+  bool greedy;
+
+  void set_lane(int node, int lane, const BinaryLightNode& s) {
+    float4* f = t.nodes.data() + size_t(node) * LT_NODE_F4;
+    float4 sp = lt_sphere_of_box(s.bmin, s.bmax);
+    float v[LT_NODE_F4] = {sp.x,
+                           sp.y,
+                           sp.z,
+                           sp.w,
+                           s.cone.axis.x,
+                           s.cone.axis.y,
+                           s.cone.axis.z,
+                           cos_of_theta_o(s.cone.theta_o),
+                           cos_of_theta_e(s.cone.theta_e),
+                           static_cast<float>(s.energy),
+                           s.cv2()};
+    for (int k = 0; k < LT_NODE_F4; ++k)
+      set_lane_value(f[k], lane, v[k]);
+  }
+
+  int make(int bi, int level, uint32_t prefix) {
+    if (level >= LT_MAX_NODE_LEVELS) {
+      if (greedy) throw TooDeep{};
+      throw std::logic_error("light tree: too deep for bit-trails");
+    }
+    int node = t.num_nodes();
+    t.children.push_back(make_int4(LT_EMPTY, LT_EMPTY, LT_EMPTY, LT_EMPTY));
+    for (int k = 0; k < LT_NODE_F4; ++k)
+      t.nodes.push_back(make_float4(0, 0, 0, 0));
+    t.nodes[size_t(node) * LT_NODE_F4 + LT_COS_O] = make_float4(1, 1, 1, 1);
+    t.levels = std::max(t.levels, level + 1);
+    int slots[4];
+    int ns = 0;
+    const BinaryLightNode& x = bt.nodes[bi];
+    if (x.is_leaf()) {
+      slots[ns++] = bi; // the root is a leaf
+    } else if (greedy) {
+      // Fill the four lanes by repeatedly opening the internal slot with the most emitters.
+      slots[ns++] = x.left;
+      slots[ns++] = x.right;
+      while (ns < 4) {
+        int best = -1;
+        for (int k = 0; k < ns; ++k)
+          if (!bt.nodes[slots[k]].is_leaf() &&
+              (best < 0 || bt.nodes[slots[k]].count > bt.nodes[slots[best]].count))
+            best = k;
+        if (best < 0) break;
+        const BinaryLightNode& open = bt.nodes[slots[best]];
+        for (int k = ns; k > best + 1; --k)
+          slots[k] = slots[k - 1];
+        slots[best] = open.left;
+        slots[best + 1] = open.right;
+        ++ns;
+      }
+    } else {
+      for (int c : {x.left, x.right}) {
+        const BinaryLightNode& cn = bt.nodes[c];
+        if (cn.is_leaf()) {
+          slots[ns++] = c;
+        } else {
+          slots[ns++] = cn.left;
+          slots[ns++] = cn.right;
+        }
+      }
+    }
+    for (int lane = 0; lane < ns; ++lane) {
+      const BinaryLightNode& s = bt.nodes[slots[lane]];
+      set_lane(node, lane, s);
+      uint32_t trail = prefix | (uint32_t(lane) << (2 * level));
+      int code;
+      if (s.is_leaf()) {
+        code = lt_leaf_code(s.first, s.count);
+        for (int j = 0; j < s.count; ++j)
+          t.trails[bt.order[s.first + j]] = trail | (uint32_t(j) << (2 * (level + 1)));
+      } else {
+        code = make(slots[lane], level + 1, trail);
+      }
+      int4& ch = t.children[node];
+      (lane == 0 ? ch.x : lane == 1 ? ch.y : lane == 2 ? ch.z : ch.w) = code;
+    }
+    return node;
+  }
+};
+} // namespace
+
+LightTree collapse_light_tree(const BinaryLightTree& bt, int num_lights) {
+  LightTree t;
+  t.num_lights = num_lights;
+  if (bt.nodes.empty()) return t;
+  for (bool greedy : {true, false}) {
+    t.trails.assign(num_lights, 0u);
+    t.leaf_lights = bt.order;
+    t.nodes.clear();
+    t.children.clear();
+    t.levels = 0;
+    t.nodes.reserve(bt.nodes.size() / 2 * LT_NODE_F4 + LT_NODE_F4);
+    t.children.reserve(bt.nodes.size() / 2 + 1);
+    Collapser c{bt, t, greedy};
+    try {
+      c.make(0, 0, 0u);
+      break;
+    } catch (const TooDeep&) {
+    }
+  }
+  const BinaryLightNode& root = bt.nodes[0];
+  t.root_sphere = lt_sphere_of_box(root.bmin, root.bmax);
+  t.root_info = make_float4(root.cv2(), static_cast<float>(root.energy), 0, 0);
+  return t;
+}
+
+LightTree build_light_tree(const std::vector<Light>& lights, const LightTreeBuildOptions& opt) {
+  std::vector<EmitterBounds> eb = emitter_bounds(lights);
+  BinaryLightTree bt = build_binary_light_tree(eb, opt);
+  return collapse_light_tree(bt, static_cast<int>(lights.size()));
+}
+
+} // namespace canopy

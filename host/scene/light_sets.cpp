@@ -1,0 +1,228 @@
+// Procedural light sets: grid, random_box, spiral, mesh_surface. Each generates `count` sites;
+// every site gets a copy of the `light` template (its position-like keys are offsets from the
+// site) and, optionally, a copy of an `instance` shape translated to the site.
+#include "scene/loader_internal.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+namespace canopy::detail {
+
+namespace {
+
+constexpr int64_t kMaxLights = 50'000'000;
+
+struct Variation {
+  bool active = false;
+  float scale_lo = 1.0f, scale_hi = 1.0f;
+  float color = 0.0f;
+};
+
+Variation parse_variation(const JsonValue& v) {
+  auto o = v.as_object();
+  o.allow({"scale", "color"});
+  Variation var;
+  var.active = true;
+  if (auto s = o.get("scale")) {
+    if (!s->is_array() || s->array_size() != 2) s->fail("must be an array [min, max]");
+    var.scale_lo = s->at(0).as_float_positive();
+    var.scale_hi = s->at(1).as_float_positive();
+    if (!(var.scale_hi >= var.scale_lo)) s->at(1).fail("must be >= scale[0]");
+  }
+  if (auto c = o.get("color")) {
+    var.color = c->as_float();
+    if (!(var.color >= 0.0f && var.color < 1.0f)) c->fail("must be in [0, 1)");
+  }
+  return var;
+}
+
+// Moves a template light to a site.
+inline Light place(const Light& t, float3 site) {
+  Light l = t;
+  l.p.x += site.x;
+  l.p.y += site.y;
+  l.p.z += site.z;
+  return l;
+}
+
+} // namespace
+
+void expand_light_set(const JsonValue& v, Builder& b) {
+  auto o = v.as_object();
+  std::string type = o.req("type").as_enum({"grid", "random_box", "spiral", "mesh_surface"});
+  Light tmpl = parse_light(o.req("light"), /*is_template=*/true);
+  uint32_t seed = 1;
+  if (auto s = o.get("seed")) seed = uint32_t(s->as_int(0, 0xffffffffLL));
+  Variation var;
+  if (auto vv = o.get("variation")) var = parse_variation(*vv);
+  std::optional<ShapeDesc> inst;
+  if (auto iv = o.get("instance")) inst = parse_shape(*iv, b);
+
+  auto count_of = [&](const char* key) { return o.req(key).as_int(1, kMaxLights); };
+
+  std::vector<float3> sites;
+  std::vector<float3> normals; // mesh_surface only
+  Pcg32 rng(seed, 0x5eed);
+
+  if (type == "grid") {
+    o.allow({"type", "light", "instance", "seed", "variation", "count", "nx", "ny", "origin",
+             "edge1", "edge2"});
+    float3 origin = o.req("origin").as_vec3();
+    float3 e1 = o.req("edge1").as_vec3();
+    float3 e2 = o.req("edge2").as_vec3();
+    int64_t nx, ny, count;
+    if (o.has("nx") || o.has("ny")) {
+      if (o.has("count")) o.req("count").fail("give either count or nx and ny, not both");
+      nx = o.req("nx").as_int(1, kMaxLights);
+      ny = o.req("ny").as_int(1, kMaxLights);
+      count = nx * ny;
+      if (count > kMaxLights) o.req("ny").fail(fmt::format("nx * ny must be <= {}", kMaxLights));
+    } else {
+      count = count_of("count");
+      nx = int64_t(std::ceil(std::sqrt(double(count))));
+      ny = (count + nx - 1) / nx;
+    }
+    sites.reserve(size_t(count));
+    for (int64_t j = 0; j < ny && int64_t(sites.size()) < count; ++j) {
+      float fy = (float(j) + 0.5f) / float(ny);
+      for (int64_t i = 0; i < nx && int64_t(sites.size()) < count; ++i) {
+        float fx = (float(i) + 0.5f) / float(nx);
+        sites.push_back(origin + e1 * fx + e2 * fy);
+      }
+    }
+  } else if (type == "random_box") {
+    o.allow({"type", "light", "instance", "seed", "variation", "count", "min", "max"});
+    float3 lo = o.req("min").as_vec3();
+    auto maxv = o.req("max");
+    float3 hi = maxv.as_vec3();
+    if (!(hi.x >= lo.x && hi.y >= lo.y && hi.z >= lo.z))
+      maxv.fail("must be >= min in every component");
+    int64_t count = count_of("count");
+    float3 ext = hi - lo;
+    sites.resize(size_t(count));
+    for (auto& s : sites) {
+      float ux = rng.uniform(), uy = rng.uniform(), uz = rng.uniform();
+      s = make_float3(lo.x + ext.x * ux, lo.y + ext.y * uy, lo.z + ext.z * uz);
+      // Rounding could land exactly on hi only, never outside [lo, hi].
+      s = fmin(fmax(s, lo), hi);
+    }
+  } else if (type == "spiral") {
+    o.allow({"type", "light", "instance", "seed", "variation", "count", "center", "radius",
+             "inner_radius", "turns", "height"});
+    float3 c = o.req("center").as_vec3();
+    float r1 = o.req("radius").as_float_positive();
+    float r0 = 0.0f;
+    if (auto iv = o.get("inner_radius")) {
+      r0 = iv->as_float_nonneg();
+      if (!(r0 < r1)) iv->fail("must be < radius");
+    }
+    float turns = o.req("turns").as_float_positive();
+    float height = o.get_float("height", 0.0f);
+    int64_t count = count_of("count");
+    sites.resize(size_t(count));
+    // Archimedean spiral r(φ) = r0 + (r1 - r0) φ / (2π turns) in the xz plane around `center`,
+    // sites at (approximately) equal arc length: r² grows linearly with the site index.
+    const double two_pi = 6.283185307179586;
+    for (int64_t i = 0; i < count; ++i) {
+      double t = count == 1 ? 0.0 : double(i) / double(count - 1);
+      double r = std::sqrt(double(r0) * r0 + (double(r1) * r1 - double(r0) * r0) * t);
+      double f = (r - r0) / (double(r1) - r0); // 0..1 along the spiral
+      double phi = two_pi * double(turns) * f;
+      sites[size_t(i)] = make_float3(c.x + float(r * std::cos(phi)), c.y + float(height * f),
+                                     c.z + float(r * std::sin(phi)));
+    }
+  } else { // mesh_surface
+    o.allow({"type", "light", "instance", "seed", "variation", "count", "shape", "offset",
+             "align_to_normal"});
+    auto sv = o.req("shape");
+    const Builder::ShapeRange* range = nullptr;
+    if (sv.is_string()) {
+      std::string name = sv.as_string();
+      for (const auto& r : b.shapes)
+        if (r.name == name) range = &r;
+      if (!range) sv.fail(fmt::format("no shape named \"{}\" (shapes are matched by name)", name));
+    } else {
+      if (b.shapes.empty()) sv.fail("there are no shapes to refer to");
+      int64_t k = sv.as_int(0, int64_t(b.shapes.size()) - 1);
+      range = &b.shapes[size_t(k)];
+    }
+    float offset = o.get_float("offset", 0.0f);
+    bool align = o.get_bool("align_to_normal", false);
+    if (align && tmpl.type != LIGHT_SPOT)
+      o.req("align_to_normal").fail("applies to spot lights only");
+    int64_t count = count_of("count");
+    const Scene& s = b.scene;
+    size_t t0 = range->first_triangle, t1 = range->end_triangle;
+    std::vector<double> cdf(t1 - t0);
+    double total = 0.0;
+    for (size_t t = t0; t < t1; ++t) {
+      float3 a = s.vertices[s.indices[3 * t]], bb = s.vertices[s.indices[3 * t + 1]],
+             c = s.vertices[s.indices[3 * t + 2]];
+      double area = 0.5 * double(length(cross(bb - a, c - a)));
+      if (!std::isfinite(area)) area = 0.0;
+      total += area;
+      cdf[t - t0] = total;
+    }
+    if (!(total > 0.0)) sv.fail("the shape has no surface area");
+    sites.resize(size_t(count));
+    normals.resize(size_t(count));
+    for (int64_t i = 0; i < count; ++i) {
+      double u = double(rng.uniform()) * total;
+      size_t k = size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin());
+      if (k >= cdf.size()) k = cdf.size() - 1;
+      // Skip zero-area triangles that upper_bound cannot land on anyway.
+      size_t t = t0 + k;
+      float3 a = s.vertices[s.indices[3 * t]], bb = s.vertices[s.indices[3 * t + 1]],
+             c = s.vertices[s.indices[3 * t + 2]];
+      float su = std::sqrt(rng.uniform()), w = rng.uniform();
+      float b0 = 1.0f - su, b1 = su * (1.0f - w), b2 = su * w;
+      float3 n = normalize(cross(bb - a, c - a));
+      sites[size_t(i)] = a * b0 + bb * b1 + c * b2 + n * offset;
+      normals[size_t(i)] = n;
+    }
+    if (!align) normals.clear();
+  }
+
+  size_t n = sites.size();
+  if (int64_t(b.scene.lights.size()) + int64_t(n) > kMaxLights)
+    v.fail(fmt::format("too many lights: the scene would have more than {}", kMaxLights));
+
+  std::vector<Light>& lights = b.scene.lights;
+  lights.reserve(lights.size() + n);
+  Pcg32 vrng(seed, 0xc010);
+  for (size_t i = 0; i < n; ++i) {
+    Light l = place(tmpl, sites[i]);
+    if (!normals.empty()) {
+      l.e1.x = normals[i].x;
+      l.e1.y = normals[i].y;
+      l.e1.z = normals[i].z;
+    }
+    if (var.active) {
+      float s = var.scale_lo + (var.scale_hi - var.scale_lo) * vrng.uniform();
+      float cr = 1.0f - var.color * vrng.uniform();
+      float cg = 1.0f - var.color * vrng.uniform();
+      float cb = 1.0f - var.color * vrng.uniform();
+      l.emission.x *= s * cr;
+      l.emission.y *= s * cg;
+      l.emission.z *= s * cb;
+    }
+    lights.push_back(l);
+  }
+  if (inst) {
+    for (size_t i = 0; i < n; ++i)
+      b.add_mesh(inst->mesh, inst->transform.then(Transform::translate(sites[i])));
+  }
+  // A site far outside float range would make positions infinite.
+  for (size_t i = lights.size() - n; i < lights.size(); ++i) {
+    const Light& l = lights[i];
+    if (!std::isfinite(l.p.x) || !std::isfinite(l.p.y) || !std::isfinite(l.p.z) ||
+        !std::isfinite(l.emission.x) || !std::isfinite(l.emission.y) ||
+        !std::isfinite(l.emission.z))
+      v.fail("generates a light with a non-finite position or emission");
+  }
+}
+
+} // namespace canopy::detail

@@ -1,0 +1,97 @@
+// Analytic lights: point, spot, sphere, quad, triangle (docs/scene-format.md, "lights").
+#include "scene/loader_internal.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace canopy::detail {
+
+bool finish_area_light(Light& l) {
+  float3 c = cross(xyz_of(l.e1), xyz_of(l.e2));
+  float len = length(c);
+  if (!(len > 0.0f) || !std::isfinite(len)) return false;
+  float3 n = c * (1.0f / len);
+  if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) return false;
+  float area = l.type == LIGHT_QUAD ? len : 0.5f * len;
+  if (!(area > 0.0f)) return false;
+  l.n = f4_from3(n, area);
+  return true;
+}
+
+namespace {
+
+float3 vec_or(const JsonObject& o, std::string_view key, bool is_template, float3 def) {
+  if (is_template) {
+    auto v = o.get(key);
+    return v ? v->as_vec3() : def;
+  }
+  return o.req(key).as_vec3();
+}
+
+} // namespace
+
+Light parse_light(const JsonValue& v, bool is_template) {
+  auto o = v.as_object();
+  std::string type = o.req("type").as_enum({"point", "spot", "sphere", "quad", "triangle"});
+  Light l{};
+  l.prim = -1;
+  const float3 zero = make_float3(0, 0, 0);
+  if (type == "point") {
+    o.allow({"type", "position", "intensity"});
+    l.type = LIGHT_POINT;
+    l.p = f4_from3(vec_or(o, "position", is_template, zero), 0.0f);
+    l.emission = f4_from3(o.req("intensity").as_emission(), 0.0f);
+  } else if (type == "spot") {
+    o.allow({"type", "position", "direction", "intensity", "cone_angle", "falloff_start"});
+    l.type = LIGHT_SPOT;
+    l.p = f4_from3(vec_or(o, "position", is_template, zero), 0.0f);
+    float3 dir = normalize(o.req("direction").as_vec3_nonzero());
+    if (!std::isfinite(dir.x) || !std::isfinite(dir.y) || !std::isfinite(dir.z))
+      o.req("direction").fail("cannot be normalised");
+    float cone = o.req("cone_angle").as_float();
+    if (!(cone > 0.0f && cone <= 180.0f)) o.req("cone_angle").fail("must be in (0, 180]");
+    float start = 0.8f * cone;
+    if (auto fs = o.get("falloff_start")) {
+      start = fs->as_float();
+      if (!(start >= 0.0f && start < cone)) fs->fail("must be in [0, cone_angle)");
+    }
+    const double d2r = 3.14159265358979323846 / 180.0;
+    l.e1 = f4_from3(dir, float(std::cos(double(cone) * d2r)));
+    l.e2 = make_float4(0, 0, 0, float(std::cos(double(start) * d2r)));
+    l.emission = f4_from3(o.req("intensity").as_emission(), 0.0f);
+  } else if (type == "sphere") {
+    o.allow({"type", "center", "radius", "radiance"});
+    l.type = LIGHT_SPHERE;
+    float3 c = vec_or(o, "center", is_template, zero);
+    float r = o.req("radius").as_float_positive();
+    l.p = f4_from3(c, r);
+    l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
+  } else if (type == "quad") {
+    o.allow({"type", "corner", "edge1", "edge2", "radiance", "two_sided"});
+    l.type = LIGHT_QUAD;
+    float3 e1 = o.req("edge1").as_vec3();
+    float3 e2 = o.req("edge2").as_vec3();
+    // As a template, the quad is centred on the generated site unless a corner offset is given.
+    float3 corner = vec_or(o, "corner", is_template, (e1 + e2) * -0.5f);
+    l.p = f4_from3(corner, 0.0f);
+    l.e1 = f4_from3(e1, 0.0f);
+    l.e2 = f4_from3(e2, 0.0f);
+    l.flags = o.get_bool("two_sided", false) ? LIGHT_FLAG_TWO_SIDED : 0;
+    l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
+    if (!finish_area_light(l)) o.fail("area must be > 0 (edge1 and edge2 are parallel or zero)");
+  } else { // triangle
+    o.allow({"type", "v0", "v1", "v2", "radiance", "two_sided"});
+    l.type = LIGHT_TRIANGLE;
+    float3 v0 = o.req("v0").as_vec3(), v1 = o.req("v1").as_vec3(), v2 = o.req("v2").as_vec3();
+    l.p = f4_from3(v0, 0.0f);
+    l.e1 = f4_from3(v1 - v0, 0.0f);
+    l.e2 = f4_from3(v2 - v0, 0.0f);
+    l.flags = o.get_bool("two_sided", false) ? LIGHT_FLAG_TWO_SIDED : 0;
+    l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
+    if (!finish_area_light(l)) o.fail("area must be > 0 (the vertices are collinear)");
+  }
+  return l;
+}
+
+} // namespace canopy::detail

@@ -1,0 +1,123 @@
+// Internals of the scene loader shared by scene_loader.cpp, shapes.cpp, obj_loader.cpp and
+// light_sets.cpp. Not part of the public interface (that is scene.h).
+#pragma once
+
+#include "scene/json_reader.h"
+#include "scene/scene.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace canopy::detail {
+
+// PCG32 (O'Neill): small, fast, and the same sequence on every platform and compiler (unlike the
+// std:: distributions), so a seed means the same scene everywhere.
+struct Pcg32 {
+  uint64_t state = 0, inc = 1;
+  Pcg32(uint64_t seed, uint64_t stream) {
+    inc = (stream << 1u) | 1u;
+    next();
+    state += seed;
+    next();
+  }
+  uint32_t next() {
+    uint64_t old = state;
+    state = old * 6364136223846793005ULL + inc;
+    uint32_t xorshifted = uint32_t(((old >> 18u) ^ old) >> 27u);
+    uint32_t rot = uint32_t(old >> 59u);
+    return (xorshifted >> rot) | (xorshifted << ((~rot + 1u) & 31u));
+  }
+  // Uniform in [0, 1): 24 random bits.
+  float uniform() { return float(next() >> 8) * (1.0f / 16777216.0f); }
+};
+
+// Affine transform: world = M * local + t. `flips` when det(M) < 0 (winding is swapped so the
+// geometric normal keeps its meaning).
+struct Transform {
+  float m[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  float3 t{0, 0, 0};
+
+  float3 apply(float3 p) const {
+    return make_float3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + t.x,
+                       m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + t.y,
+                       m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + t.z);
+  }
+  float det() const {
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  }
+  bool flips() const { return det() < 0.0f; }
+  // this ∘ other: first other, then this.
+  Transform then(const Transform& outer) const;
+  static Transform translate(float3 d);
+  static Transform scale(float3 s);
+  static Transform rotate(float3 unit_axis, float degrees);
+};
+
+// A triangle mesh in local space, before it is placed into the scene.
+struct Mesh {
+  std::vector<float3> vertices;
+  std::vector<uint32_t> indices; // 3 per triangle
+  std::vector<int32_t> material; // per triangle
+  std::vector<float3> emission;  // per triangle radiance; (0,0,0) = not emissive
+  bool two_sided_emission = false;
+
+  size_t triangle_count() const { return indices.size() / 3; }
+  void add_triangle(uint32_t a, uint32_t b, uint32_t c, int32_t mat, float3 em) {
+    indices.insert(indices.end(), {a, b, c});
+    material.push_back(mat);
+    emission.push_back(em);
+  }
+};
+
+// Mutable state while a scene is built.
+struct Builder {
+  Scene& scene;
+  std::string file;                               // name used in messages
+  std::filesystem::path base_dir;                 // resolves relative file names
+  std::map<std::string, int> material_by_name;    // scene materials (from the JSON)
+  std::map<std::string, int> mtl_material_by_key; // MTL materials: "<mtl file>\n<name>"
+  struct ShapeRange {
+    std::string name;
+    size_t first_triangle = 0, end_triangle = 0;
+  };
+  std::vector<ShapeRange> shapes; // one per entry of "shapes", in order
+
+  // Index of the material named by a JSON string value, or an error at that value.
+  int material_ref(const JsonValue& v) const;
+  // Index of an MTL material (created on first use) unless the scene defines one with that name.
+  int mtl_material(const std::string& mtl_file, const std::string& name, float3 kd);
+  // Appends a mesh to the triangle soup (transformed) and creates its mesh lights. Returns the
+  // index of its first triangle.
+  size_t add_mesh(const Mesh& mesh, const Transform& xf);
+};
+
+// Shapes (shapes.cpp): parses one shape object ("obj", "quad", "box") into a local mesh plus its
+// transform. Used for "shapes" entries and for instanced shapes of light sets.
+struct ShapeDesc {
+  Mesh mesh;
+  Transform transform;
+  std::string name;
+};
+ShapeDesc parse_shape(const JsonValue& v, Builder& b);
+Transform parse_transform(const JsonValue& v);
+
+// OBJ + MTL (obj_loader.cpp). `at` is the JSON value naming the file (for messages).
+// material_override >= 0 replaces every MTL material.
+Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b,
+              int material_override);
+
+// Lights (lights.cpp).
+// An analytic light from a JSON object. As a template of a light set, position-like keys are
+// offsets from the generated site and may be omitted (quad/triangle are then centred on the site).
+Light parse_light(const JsonValue& v, bool is_template);
+// Fills n (unit normal, area in w) of a quad/triangle light; false if the area is zero.
+bool finish_area_light(Light& l);
+// Light sets (light_sets.cpp): expands one entry of "light_sets".
+void expand_light_set(const JsonValue& v, Builder& b);
+
+} // namespace canopy::detail

@@ -1,0 +1,292 @@
+// load_scene / load_scene_from_string: the top level of the scene format (docs/scene-format.md).
+#include "scene/loader_internal.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace canopy {
+namespace detail {
+
+// ------------------------------------------------------------------------------------ Transform
+
+Transform Transform::then(const Transform& outer) const {
+  Transform r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      r.m[i][j] = outer.m[i][0] * m[0][j] + outer.m[i][1] * m[1][j] + outer.m[i][2] * m[2][j];
+  r.t = outer.apply(t);
+  return r;
+}
+
+Transform Transform::translate(float3 d) {
+  Transform r;
+  r.t = d;
+  return r;
+}
+
+Transform Transform::scale(float3 s) {
+  Transform r;
+  r.m[0][0] = s.x;
+  r.m[1][1] = s.y;
+  r.m[2][2] = s.z;
+  return r;
+}
+
+Transform Transform::rotate(float3 a, float degrees) {
+  // Rodrigues; the angle in double so 90 degrees gives exact zeros where it should.
+  double th = double(degrees) * (3.14159265358979323846 / 180.0);
+  double c = std::cos(th), s = std::sin(th), C = 1.0 - c;
+  double x = a.x, y = a.y, z = a.z;
+  Transform r;
+  double m[3][3] = {{c + x * x * C, x * y * C - z * s, x * z * C + y * s},
+                    {y * x * C + z * s, c + y * y * C, y * z * C - x * s},
+                    {z * x * C - y * s, z * y * C + x * s, c + z * z * C}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double v = m[i][j];
+      r.m[i][j] = std::fabs(v) < 1e-15 ? 0.0f : float(v);
+    }
+  return r;
+}
+
+// -------------------------------------------------------------------------------------- Builder
+
+int Builder::material_ref(const JsonValue& v) const {
+  std::string name = v.as_string();
+  auto it = material_by_name.find(name);
+  if (it == material_by_name.end()) v.fail(fmt::format("unknown material \"{}\"", name));
+  return it->second;
+}
+
+int Builder::mtl_material(const std::string& mtl_file, const std::string& name, float3 kd) {
+  // A scene material with the same name wins: it lets a scene recolour an OBJ.
+  if (auto it = material_by_name.find(name); it != material_by_name.end()) return it->second;
+  std::string key = mtl_file + "\n" + name;
+  if (auto it = mtl_material_by_key.find(key); it != mtl_material_by_key.end()) return it->second;
+  MaterialDesc d;
+  d.name = name;
+  d.gpu = Material{};
+  d.gpu.albedo = make_float4(kd.x, kd.y, kd.z, 0.0f);
+  d.gpu.type = MATERIAL_DIFFUSE;
+  int idx = int(scene.materials.size());
+  scene.materials.push_back(d);
+  mtl_material_by_key.emplace(key, idx);
+  return idx;
+}
+
+namespace {
+// reserve() with geometric growth: many small meshes (instances) must not reallocate every time.
+template <class T> void reserve_more(std::vector<T>& v, size_t extra) {
+  size_t need = v.size() + extra;
+  if (need > v.capacity()) v.reserve(std::max(need, 2 * v.capacity()));
+}
+} // namespace
+
+size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
+  Scene& s = scene;
+  size_t first_tri = s.triangle_count();
+  if (s.vertices.size() + mesh.vertices.size() > size_t(std::numeric_limits<uint32_t>::max()))
+    throw SceneError(fmt::format("{}: shapes: too many vertices (more than 2^32)", file));
+  uint32_t base = uint32_t(s.vertices.size());
+  reserve_more(s.vertices, mesh.vertices.size());
+  for (const float3& v : mesh.vertices)
+    s.vertices.push_back(xf.apply(v));
+  bool flip = xf.flips();
+  size_t nt = mesh.triangle_count();
+  reserve_more(s.indices, 3 * nt);
+  reserve_more(s.triangle_material, nt);
+  reserve_more(s.triangle_light, nt);
+  for (size_t t = 0; t < nt; ++t) {
+    uint32_t a = base + mesh.indices[3 * t], bb = base + mesh.indices[3 * t + 1],
+             c = base + mesh.indices[3 * t + 2];
+    if (flip) std::swap(bb, c);
+    s.indices.insert(s.indices.end(), {a, bb, c});
+    s.triangle_material.push_back(mesh.material[t]);
+    int32_t light = -1;
+    float3 em = mesh.emission[t];
+    if (em.x > 0.0f || em.y > 0.0f || em.z > 0.0f) {
+      Light l{};
+      float3 v0 = s.vertices[a], v1 = s.vertices[bb], v2 = s.vertices[c];
+      l.p = f4_from3(v0, 0.0f);
+      l.e1 = f4_from3(v1 - v0, 0.0f);
+      l.e2 = f4_from3(v2 - v0, 0.0f);
+      l.emission = f4_from3(em, 0.0f);
+      l.type = LIGHT_TRIANGLE;
+      l.flags = LIGHT_FLAG_FROM_MESH | (mesh.two_sided_emission ? LIGHT_FLAG_TWO_SIDED : 0);
+      l.prim = -1;
+      // A zero-area triangle of an emissive mesh stays in the geometry but is no light.
+      if (finish_area_light(l)) {
+        light = int32_t(s.lights.size());
+        s.lights.push_back(l);
+      }
+    }
+    s.triangle_light.push_back(light);
+  }
+  return first_tri;
+}
+
+// ------------------------------------------------------------------------------ top-level parts
+
+namespace {
+
+void parse_camera(const JsonValue& v, Camera& cam) {
+  auto o = v.as_object();
+  o.allow({"position", "look_at", "up", "fov"});
+  cam.position = o.req("position").as_vec3();
+  auto look = o.req("look_at");
+  cam.look_at = look.as_vec3();
+  float3 dir = cam.look_at - cam.position;
+  if (dir.x == 0.0f && dir.y == 0.0f && dir.z == 0.0f)
+    look.fail("must differ from camera.position");
+  if (!std::isfinite(dot(dir, dir))) look.fail("is too far from camera.position");
+  if (auto up = o.get("up")) {
+    cam.up = up->as_vec3_nonzero();
+    float3 d = normalize(dir), u = normalize(cam.up);
+    float3 c = cross(d, u);
+    if (!(std::sqrt(dot(c, c)) > 1e-4f)) up->fail("must not be parallel to the view direction");
+  } else {
+    cam.up = make_float3(0, 1, 0);
+    float3 d = normalize(dir);
+    if (std::fabs(d.x) < 1e-4f && std::fabs(d.z) < 1e-4f)
+      throw_error(v.file(), o.child_path("up"),
+                  "the default [0, 1, 0] is parallel to the view direction; give camera.up");
+  }
+  if (auto f = o.get("fov")) cam.fov_y_deg = f->as_float_open(0.0f, 180.0f);
+}
+
+void parse_film(const JsonValue& v, FilmSettings& film) {
+  auto o = v.as_object();
+  o.allow({"width", "height"});
+  if (auto w = o.get("width")) film.width = int(w->as_int(1, 16384));
+  if (auto h = o.get("height")) film.height = int(h->as_int(1, 16384));
+}
+
+void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
+  auto o = v.as_object();
+  o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "seed"});
+  if (auto x = o.get("spp")) in.spp = int(x->as_int(1, 1 << 24));
+  if (auto x = o.get("max_depth")) in.max_depth = int(x->as_int(1, 1024));
+  if (auto x = o.get("light_sampler"))
+    in.light_sampler = x->as_enum({"uniform", "power", "tree", "tree-split", "exhaustive"});
+  if (auto x = o.get("split_threshold")) in.split_threshold = x->as_float_in(0.0f, 1.0f);
+  if (auto x = o.get("seed")) in.seed = uint32_t(x->as_int(0, 0xffffffffLL));
+}
+
+void parse_materials(const JsonValue& v, Builder& b) {
+  Scene& s = b.scene;
+  bool default_replaced = false;
+  for (const JsonValue& mv : v.as_array()) {
+    auto o = mv.as_object();
+    o.allow({"name", "type", "albedo"});
+    auto nv = o.req("name");
+    std::string name = nv.as_string();
+    if (name.empty()) nv.fail("must not be empty");
+    if (auto t = o.get("type")) t->as_enum({"diffuse"});
+    MaterialDesc d;
+    d.name = name;
+    d.gpu = Material{};
+    d.gpu.type = MATERIAL_DIFFUSE;
+    float3 a = o.req("albedo").as_albedo();
+    d.gpu.albedo = make_float4(a.x, a.y, a.z, 0.0f);
+    if (name == "default" && !default_replaced) {
+      s.materials[0] = d; // replaces the built-in default
+      default_replaced = true;
+      continue;
+    }
+    if (b.material_by_name.count(name))
+      nv.fail(fmt::format("duplicate material name \"{}\"", name));
+    b.material_by_name[name] = int(s.materials.size());
+    s.materials.push_back(d);
+  }
+}
+
+void parse_shapes(const JsonValue& v, Builder& b) {
+  for (const JsonValue& sv : v.as_array()) {
+    ShapeDesc d = parse_shape(sv, b);
+    if (!d.name.empty())
+      for (const auto& r : b.shapes)
+        if (r.name == d.name)
+          sv.as_object().req("name").fail(fmt::format("duplicate shape name \"{}\"", d.name));
+    size_t first = b.add_mesh(d.mesh, d.transform);
+    b.shapes.push_back({d.name, first, b.scene.triangle_count()});
+  }
+}
+
+} // namespace
+} // namespace detail
+
+namespace {
+
+Scene load_from_string(const std::string& json_text, const std::string& name,
+                       const std::filesystem::path& base_dir) {
+  using namespace detail;
+  json doc = parse_json(json_text, name);
+  Scene scene;
+  scene.path = name;
+  MaterialDesc def;
+  def.name = "default";
+  def.gpu = Material{};
+  def.gpu.albedo = make_float4(0.8f, 0.8f, 0.8f, 0.0f);
+  def.gpu.type = MATERIAL_DIFFUSE;
+  scene.materials.push_back(def);
+
+  Builder b{scene, name, base_dir, {}, {}, {}};
+  b.material_by_name["default"] = 0;
+
+  JsonValue root(doc, "", name);
+  auto o = root.as_object();
+  o.allow({"camera", "film", "integrator", "materials", "shapes", "lights", "light_sets"});
+  parse_camera(o.req("camera"), scene.camera);
+  if (auto x = o.get("film")) parse_film(*x, scene.film);
+  if (auto x = o.get("integrator")) parse_integrator(*x, scene.integrator);
+  if (auto x = o.get("materials")) parse_materials(*x, b);
+  if (auto x = o.get("shapes")) parse_shapes(*x, b);
+  if (auto x = o.get("lights")) {
+    size_t n = x->array_size();
+    scene.lights.reserve(scene.lights.size() + n);
+    for (size_t i = 0; i < n; ++i)
+      scene.lights.push_back(parse_light(x->at(i), false));
+  }
+  if (auto x = o.get("light_sets")) {
+    for (const JsonValue& sv : x->as_array())
+      expand_light_set(sv, b);
+  }
+  if (scene.lights.empty())
+    throw_error(name, "lights",
+                "the scene has no emitters (add lights, light_sets or an emissive shape)");
+  return scene;
+}
+
+} // namespace
+
+Scene load_scene_from_string(const std::string& json_text, const std::string& name,
+                             const std::filesystem::path& base_dir) {
+  try {
+    return load_from_string(json_text, name, base_dir);
+  } catch (const std::bad_alloc&) {
+    throw SceneError(fmt::format("{}: out of memory while building the scene", name));
+  } catch (const std::length_error&) {
+    throw SceneError(fmt::format("{}: out of memory while building the scene", name));
+  }
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  std::string name = file.string();
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw SceneError(fmt::format("{}: cannot open file (it is a directory)", name));
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SceneError(fmt::format("{}: cannot open file", name));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw SceneError(fmt::format("{}: cannot read file", name));
+  Scene s = load_scene_from_string(ss.str(), name, file.parent_path());
+  s.path = file;
+  return s;
+}
+
+} // namespace canopy

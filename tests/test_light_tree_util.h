@@ -1,0 +1,131 @@
+// Helpers shared by the light-tree tests.
+#pragma once
+
+#include "lighttree/light_sampler.h"
+#include "lighttree/synthetic_lights.h"
+
+#include <cmath>
+#include <vector>
+
+namespace canopy::test {
+
+inline double dot_d(float3 a, float3 b) {
+  return double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z;
+}
+inline double angle_d(float3 a, float3 b) { // accurate angle between (not necessarily unit) vectors
+  double cx = double(a.y) * b.z - double(a.z) * b.y;
+  double cy = double(a.z) * b.x - double(a.x) * b.z;
+  double cz = double(a.x) * b.y - double(a.y) * b.x;
+  return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot_d(a, b));
+}
+
+inline float3 random_unit(LtRng& r) {
+  float z = 2.0f * lt_rng_next(&r) - 1.0f;
+  float phi = 2.0f * M_PI_F * lt_rng_next(&r);
+  float s = std::sqrt(std::fmax(0.0f, 1.0f - z * z));
+  return make_float3(s * std::cos(phi), s * std::sin(phi), z);
+}
+
+// Points on (or at) a light: the reference points of the test contribution.
+inline std::vector<float3> light_points(const Light& l) {
+  float3 p = xyz_of(l.p);
+  std::vector<float3> pts;
+  if (l.type == LIGHT_QUAD) {
+    float3 a = xyz_of(l.e1), b = xyz_of(l.e2);
+    for (float u : {0.02f, 0.5f, 0.98f})
+      for (float v : {0.02f, 0.5f, 0.98f})
+        pts.push_back(p + a * u + b * v);
+  } else if (l.type == LIGHT_TRIANGLE) {
+    float3 a = xyz_of(l.e1), b = xyz_of(l.e2);
+    for (float u : {0.02f, 0.33f, 0.96f})
+      for (float v : {0.02f, 0.33f})
+        pts.push_back(p + a * u + b * (v * (1.0f - u)));
+  } else {
+    pts.push_back(p);
+  }
+  return pts;
+}
+
+// A deterministic stand-in for a light's unoccluded contribution at (P, N): energy times the
+// emitter and receiver cosines over d^2 at the light's centroid (a sphere: its centre, facing P).
+// It is 0 exactly where the light cannot contribute (behind P's horizon, outside its emission).
+inline double contribution(const Light& l, float3 P, float3 N) {
+  EmitterBounds b = emitter_bounds(l);
+  std::vector<float3> pts = light_points(l);
+  float3 y = pts[pts.size() / 2];
+  double dx = double(y.x) - P.x, dy = double(y.y) - P.y, dz = double(y.z) - P.z;
+  double d2 = dx * dx + dy * dy + dz * dz;
+  if (!(d2 > 1e-12)) return 0.0;
+  double d = std::sqrt(d2);
+  double ux = dx / d, uy = dy / d, uz = dz / d; // P -> light
+  double cos_i = 1.0;
+  if (N.x != 0 || N.y != 0 || N.z != 0) cos_i = std::max(0.0, ux * N.x + uy * N.y + uz * N.z);
+  double cos_l = 1.0;
+  if (l.type == LIGHT_SPOT) {
+    double c = -(ux * l.e1.x + uy * l.e1.y + uz * l.e1.z);
+    cos_l = c >= l.e1.w ? 1.0 : 0.0;
+  } else if (l.type == LIGHT_QUAD || l.type == LIGHT_TRIANGLE) {
+    double c = -(ux * b.cone.axis.x + uy * b.cone.axis.y + uz * b.cone.axis.z);
+    cos_l = (l.flags & LIGHT_FLAG_TWO_SIDED) ? std::fabs(c) : std::max(0.0, c);
+  }
+  return double(b.energy) * cos_i * cos_l / d2;
+}
+
+// Whether some point of the light is clearly visible from P's hemisphere and emits towards P
+// (both cosines above 1e-3): such a light must get a non-zero pmf.
+inline bool clearly_contributes(const Light& l, float3 P, float3 N) {
+  EmitterBounds b = emitter_bounds(l);
+  if (!(b.energy > 0)) return false;
+  for (float3 y : light_points(l)) {
+    double dx = double(y.x) - P.x, dy = double(y.y) - P.y, dz = double(y.z) - P.z;
+    double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (!(d > 1e-6)) continue;
+    double ux = dx / d, uy = dy / d, uz = dz / d;
+    double cos_i = (N.x != 0 || N.y != 0 || N.z != 0) ? ux * N.x + uy * N.y + uz * N.z : 1.0;
+    double cos_l = 1.0;
+    if (l.type == LIGHT_SPOT) {
+      double c = -(ux * l.e1.x + uy * l.e1.y + uz * l.e1.z);
+      cos_l = c - l.e1.w; // inside the aperture by a margin
+    } else if (l.type == LIGHT_QUAD || l.type == LIGHT_TRIANGLE) {
+      double c = -(ux * b.cone.axis.x + uy * b.cone.axis.y + uz * b.cone.axis.z);
+      cos_l = (l.flags & LIGHT_FLAG_TWO_SIDED) ? std::fabs(c) : c;
+    }
+    if (cos_i > 1e-3 && cos_l > 1e-3) return true;
+  }
+  return false;
+}
+
+// Wilson-Hilferty normal score of a chi-square statistic with k degrees of freedom.
+inline double chi2_z(double chi2, double k) {
+  double h = 2.0 / (9.0 * k);
+  return (std::cbrt(chi2 / k) - (1.0 - h)) / std::sqrt(h);
+}
+
+// Chi-square of observed counts against expected probabilities (bins with expected count < 5 are
+// pooled). Returns the normal score; *dof the degrees of freedom.
+inline double chi2_score(const std::vector<double>& observed, const std::vector<double>& prob,
+                         double total, int* dof = nullptr) {
+  double chi2 = 0, pool_o = 0, pool_e = 0;
+  int bins = 0;
+  for (size_t i = 0; i < observed.size(); ++i) {
+    double e = prob[i] * total;
+    if (e < 5.0) {
+      pool_o += observed[i];
+      pool_e += e;
+      continue;
+    }
+    chi2 += (observed[i] - e) * (observed[i] - e) / e;
+    ++bins;
+  }
+  if (pool_e >= 5.0) {
+    chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+    ++bins;
+  } else if (pool_o > 10.0) {
+    chi2 += 1e9; // many picks where almost none are expected
+  }
+  int k = std::max(1, bins - 1);
+  if (dof) *dof = k;
+  return chi2_z(chi2, k);
+}
+
+} // namespace canopy::test

@@ -1,0 +1,286 @@
+// Good scenes: every value lands where docs/scene-format.md says it does.
+#include "test_scene_util.h"
+
+#include <cmath>
+
+using namespace canopy;
+using namespace canopy::test;
+
+namespace {
+
+float3 tri_normal(const Scene& s, size_t t) {
+  float3 a = s.vertices[s.indices[3 * t]], b = s.vertices[s.indices[3 * t + 1]],
+         c = s.vertices[s.indices[3 * t + 2]];
+  return normalize(cross(b - a, c - a));
+}
+
+float3 tri_centroid(const Scene& s, size_t t) {
+  float3 a = s.vertices[s.indices[3 * t]], b = s.vertices[s.indices[3 * t + 1]],
+         c = s.vertices[s.indices[3 * t + 2]];
+  return (a + b + c) * (1.0f / 3.0f);
+}
+
+constexpr float kDeg = 3.14159265358979323846f / 180.0f;
+
+} // namespace
+
+TEST(SceneLoader, CameraFilmIntegrator) {
+  Scene s = load_str(R"({
+    "camera": {"position": [1, 2, 3], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 60},
+    "film": {"width": 320, "height": 200},
+    "integrator": {"spp": 7, "max_depth": 4, "light_sampler": "tree-split",
+                   "split_threshold": 0.5, "seed": 4294967295},
+    "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}]
+  })");
+  EXPECT_FLOAT_EQ(s.camera.position.x, 1);
+  EXPECT_FLOAT_EQ(s.camera.position.y, 2);
+  EXPECT_FLOAT_EQ(s.camera.position.z, 3);
+  EXPECT_FLOAT_EQ(s.camera.up.z, 1);
+  EXPECT_FLOAT_EQ(s.camera.fov_y_deg, 60);
+  EXPECT_EQ(s.film.width, 320);
+  EXPECT_EQ(s.film.height, 200);
+  EXPECT_EQ(s.integrator.spp, 7);
+  EXPECT_EQ(s.integrator.max_depth, 4);
+  EXPECT_EQ(s.integrator.light_sampler, "tree-split");
+  EXPECT_FLOAT_EQ(s.integrator.split_threshold, 0.5f);
+  EXPECT_EQ(s.integrator.seed, 4294967295u);
+  EXPECT_EQ(s.path, "scene.json");
+}
+
+TEST(SceneLoader, Defaults) {
+  Scene s = load_str(scene_with(""));
+  EXPECT_FLOAT_EQ(s.camera.up.y, 1);
+  EXPECT_FLOAT_EQ(s.camera.fov_y_deg, 45);
+  EXPECT_EQ(s.film.width, 640);
+  EXPECT_EQ(s.film.height, 480);
+  EXPECT_EQ(s.integrator.spp, 16);
+  EXPECT_EQ(s.integrator.max_depth, 1);
+  EXPECT_EQ(s.integrator.light_sampler, "uniform");
+  EXPECT_FLOAT_EQ(s.integrator.split_threshold, 0.85f);
+  EXPECT_EQ(s.integrator.seed, 1u);
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.materials[0].name, "default");
+  EXPECT_FLOAT_EQ(s.materials[0].gpu.albedo.x, 0.8f);
+  EXPECT_EQ(s.triangle_count(), 0u);
+}
+
+TEST(SceneLoader, CommentsAndIntegralFloats) {
+  Scene s = load_str(R"({
+    // a comment
+    "camera": {"position": [0, 1, 5], "look_at": [0, 1, 0]}, /* another */
+    "film": {"width": 1e3, "height": 5.0e2},
+    "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}]
+  })");
+  EXPECT_EQ(s.film.width, 1000);
+  EXPECT_EQ(s.film.height, 500);
+}
+
+TEST(SceneLoader, Materials) {
+  Scene s = load_str(scene_with(R"("materials": [
+      {"name": "red", "albedo": [0.9, 0.1, 0.0]},
+      {"name": "grey", "type": "diffuse", "albedo": 0.25},
+      {"name": "default", "albedo": 0.5}])"));
+  ASSERT_EQ(s.materials.size(), 3u);
+  EXPECT_EQ(s.materials[0].name, "default"); // replaced in place: index 0 stays the default
+  EXPECT_FLOAT_EQ(s.materials[0].gpu.albedo.y, 0.5f);
+  EXPECT_EQ(s.materials[1].name, "red");
+  EXPECT_FLOAT_EQ(s.materials[1].gpu.albedo.x, 0.9f);
+  EXPECT_FLOAT_EQ(s.materials[1].gpu.albedo.y, 0.1f);
+  EXPECT_EQ(s.materials[1].gpu.type, MATERIAL_DIFFUSE);
+  EXPECT_FLOAT_EQ(s.materials[2].gpu.albedo.z, 0.25f);
+}
+
+TEST(SceneLoader, PointAndSpot) {
+  Scene s = load_str(scene_with("", R"([
+      {"type": "point", "position": [1, 2, 3], "intensity": [4, 5, 6]},
+      {"type": "spot", "position": [0, 3, 0], "direction": [0, -2, 0], "intensity": 10,
+       "cone_angle": 30, "falloff_start": 20},
+      {"type": "spot", "position": [0, 3, 0], "direction": [1, 0, 0], "intensity": 1,
+       "cone_angle": 50}])"));
+  ASSERT_EQ(s.lights.size(), 3u);
+  const Light& p = s.lights[0];
+  EXPECT_EQ(p.type, LIGHT_POINT);
+  EXPECT_EQ(p.prim, -1);
+  EXPECT_EQ(p.flags, 0);
+  EXPECT_FLOAT_EQ(p.p.x, 1);
+  EXPECT_FLOAT_EQ(p.p.z, 3);
+  EXPECT_FLOAT_EQ(p.emission.x, 4);
+  EXPECT_FLOAT_EQ(p.emission.z, 6);
+  const Light& sp = s.lights[1];
+  EXPECT_EQ(sp.type, LIGHT_SPOT);
+  EXPECT_EQ(sp.prim, -1);
+  EXPECT_FLOAT_EQ(sp.e1.x, 0);
+  EXPECT_FLOAT_EQ(sp.e1.y, -1); // unit axis
+  EXPECT_NEAR(sp.e1.w, std::cos(30 * kDeg), 1e-6f);
+  EXPECT_NEAR(sp.e2.w, std::cos(20 * kDeg), 1e-6f);
+  EXPECT_FLOAT_EQ(sp.emission.y, 10);
+  // Default falloff start: 80% of the cone angle.
+  EXPECT_NEAR(s.lights[2].e2.w, std::cos(40 * kDeg), 1e-6f);
+}
+
+TEST(SceneLoader, SphereQuadTriangle) {
+  Scene s = load_str(scene_with("", R"([
+      {"type": "sphere", "center": [1, 2, 3], "radius": 0.5, "radiance": [1, 2, 3]},
+      {"type": "quad", "corner": [0, 2, 0], "edge1": [2, 0, 0], "edge2": [0, 0, 3],
+       "radiance": 7},
+      {"type": "quad", "corner": [0, 2, 0], "edge1": [0, 0, 3], "edge2": [2, 0, 0],
+       "radiance": 7, "two_sided": true},
+      {"type": "triangle", "v0": [0, 0, 0], "v1": [2, 0, 0], "v2": [0, 2, 0], "radiance": 1}])"));
+  ASSERT_EQ(s.lights.size(), 4u);
+  const Light& sp = s.lights[0];
+  EXPECT_EQ(sp.type, LIGHT_SPHERE);
+  EXPECT_FLOAT_EQ(sp.p.y, 2);
+  EXPECT_FLOAT_EQ(sp.p.w, 0.5f);
+  EXPECT_FLOAT_EQ(sp.emission.z, 3);
+  const Light& q = s.lights[1];
+  EXPECT_EQ(q.type, LIGHT_QUAD);
+  EXPECT_EQ(q.flags, 0);
+  EXPECT_FLOAT_EQ(q.p.y, 2);
+  EXPECT_FLOAT_EQ(q.e1.x, 2);
+  EXPECT_FLOAT_EQ(q.e2.z, 3);
+  // cross([2,0,0], [0,0,3]) = [0,-6,0]: facing down, area 6.
+  EXPECT_FLOAT_EQ(q.n.x, 0);
+  EXPECT_FLOAT_EQ(q.n.y, -1);
+  EXPECT_FLOAT_EQ(q.n.z, 0);
+  EXPECT_FLOAT_EQ(q.n.w, 6);
+  const Light& q2 = s.lights[2];
+  EXPECT_FLOAT_EQ(q2.n.y, 1);
+  EXPECT_EQ(q2.flags, LIGHT_FLAG_TWO_SIDED);
+  const Light& t = s.lights[3];
+  EXPECT_EQ(t.type, LIGHT_TRIANGLE);
+  EXPECT_EQ(t.prim, -1);
+  EXPECT_FLOAT_EQ(t.n.z, 1);
+  EXPECT_FLOAT_EQ(t.n.w, 2); // |cross| / 2
+  EXPECT_FLOAT_EQ(t.e2.y, 2);
+  // Analytic lights are not in the triangle soup.
+  EXPECT_EQ(s.triangle_count(), 0u);
+}
+
+TEST(SceneLoader, QuadAndBoxShapes) {
+  Scene s = load_str(scene_with(R"(
+      "materials": [{"name": "m", "albedo": 0.3}],
+      "shapes": [
+        {"type": "quad", "corner": [0, 0, 0], "edge1": [0, 0, 1], "edge2": [1, 0, 0],
+         "material": "m"},
+        {"type": "box", "min": [-1, -2, -3], "max": [1, 2, 3]}])"));
+  ASSERT_EQ(s.triangle_count(), 2u + 12u);
+  EXPECT_EQ(s.triangle_material[0], 1);
+  EXPECT_EQ(s.triangle_material[2], 0); // the box: default material
+  for (size_t t = 0; t < 2; ++t)
+    EXPECT_FLOAT_EQ(tri_normal(s, t).y, 1.0f);
+  for (size_t t = 2; t < 14; ++t) {
+    // Outward: the normal points away from the box centre (the origin).
+    EXPECT_GT(dot(tri_normal(s, t), tri_centroid(s, t)), 0.0f) << "triangle " << t;
+    EXPECT_EQ(s.triangle_light[t], -1);
+  }
+  EXPECT_EQ(s.vertices.size(), 4u + 24u);
+}
+
+TEST(SceneLoader, BoxRotateY) {
+  Scene s = load_str(scene_with(R"("shapes": [
+      {"type": "box", "min": [1, 0, -1], "max": [3, 1, 1], "rotate_y": 90}])"));
+  // Rotation about the box's own vertical axis (x = 2, z = 0): x extent becomes [1.0, 3.0] in z
+  // terms: the 2 x 1 x 2 box is square in xz, so its footprint stays [1,3] x [-1,1].
+  for (const float3& v : s.vertices) {
+    EXPECT_NEAR(std::fabs(v.x - 2.0f), 1.0f, 1e-5f);
+    EXPECT_NEAR(std::fabs(v.z), 1.0f, 1e-5f);
+  }
+}
+
+TEST(SceneLoader, TransformOrder) {
+  // scale, then rotate, then translate.
+  Scene s = load_str(scene_with(R"("shapes": [
+      {"type": "obj", "file": "triangle.obj",
+       "transform": {"scale": 2, "rotate": {"axis": [0, 0, 1], "degrees": 90},
+                     "translate": [10, 0, 0]}}])"));
+  ASSERT_EQ(s.vertices.size(), 3u);
+  // (1,0,0) -> (2,0,0) -> (0,2,0) -> (10,2,0)
+  EXPECT_NEAR(s.vertices[1].x, 10.0f, 1e-5f);
+  EXPECT_NEAR(s.vertices[1].y, 2.0f, 1e-5f);
+  // (0,1,0) -> (0,2,0) -> (-2,0,0) -> (8,0,0)
+  EXPECT_NEAR(s.vertices[2].x, 8.0f, 1e-5f);
+  EXPECT_NEAR(s.vertices[2].y, 0.0f, 1e-5f);
+}
+
+TEST(SceneLoader, MirrorKeepsNormalMeaning) {
+  // A mirroring scale swaps the winding, so the geometric normal is the transformed normal
+  // (inverse transpose): the triangle's +z normal mirrored in z is -z ...
+  Scene s = load_str(scene_with(R"("shapes": [
+      {"type": "obj", "file": "triangle.obj", "transform": {"scale": [1, 1, -1]}}])"));
+  EXPECT_FLOAT_EQ(tri_normal(s, 0).z, -1.0f);
+  // ... and mirrored in x it stays +z (without the swap it would flip).
+  Scene s2 = load_str(scene_with(R"("shapes": [
+      {"type": "obj", "file": "triangle.obj", "transform": {"scale": [-1, 1, 1]}}])"));
+  EXPECT_FLOAT_EQ(tri_normal(s2, 0).z, 1.0f);
+}
+
+TEST(SceneLoader, ObjMtlEmission) {
+  Scene s = load_str(scene_with(R"("shapes": [{"type": "obj", "file": "emissive.obj"}])", "[]"));
+  // 2 (quad) + 1 (degenerate) + 1 (floor) triangles
+  ASSERT_EQ(s.triangle_count(), 4u);
+  ASSERT_EQ(s.lights.size(), 2u); // the zero-area triangle is no light
+  // materials: default, lamp, grey (named after the MTL)
+  ASSERT_EQ(s.materials.size(), 3u);
+  EXPECT_EQ(s.materials[1].name, "lamp");
+  EXPECT_EQ(s.materials[2].name, "grey");
+  EXPECT_FLOAT_EQ(s.materials[2].gpu.albedo.x, 0.5f);
+  EXPECT_EQ(s.triangle_material[0], 1);
+  EXPECT_EQ(s.triangle_material[3], 2);
+  EXPECT_EQ(s.triangle_light[0], 0);
+  EXPECT_EQ(s.triangle_light[1], 1);
+  EXPECT_EQ(s.triangle_light[2], -1);
+  EXPECT_EQ(s.triangle_light[3], -1);
+  for (int i = 0; i < 2; ++i) {
+    const Light& l = s.lights[size_t(i)];
+    EXPECT_EQ(l.type, LIGHT_TRIANGLE);
+    EXPECT_EQ(l.flags, LIGHT_FLAG_FROM_MESH);
+    EXPECT_EQ(l.prim, -1);
+    EXPECT_FLOAT_EQ(l.emission.x, 5);
+    EXPECT_FLOAT_EQ(l.emission.y, 4);
+    EXPECT_FLOAT_EQ(l.emission.z, 3);
+    EXPECT_FLOAT_EQ(l.n.w, 0.5f);
+    // p = v0, e1 = v1 - v0, e2 = v2 - v0 of the triangle it belongs to
+    size_t t = size_t(i);
+    float3 v0 = s.vertices[s.indices[3 * t]], v1 = s.vertices[s.indices[3 * t + 1]];
+    EXPECT_FLOAT_EQ(l.p.x, v0.x);
+    EXPECT_FLOAT_EQ(l.e1.x, v1.x - v0.x);
+    EXPECT_FLOAT_EQ(l.e1.z, v1.z - v0.z);
+    float3 n = tri_normal(s, t);
+    EXPECT_FLOAT_EQ(l.n.y, n.y);
+  }
+  // f 1 2 3 4 at y = 1 is wound clockwise seen from above: it faces down.
+  EXPECT_FLOAT_EQ(s.lights[0].n.y, -1.0f);
+}
+
+TEST(SceneLoader, ObjMaterialOverrideAndSceneEmission) {
+  Scene s = load_str(scene_with(R"(
+      "materials": [{"name": "grey", "albedo": 0.2}, {"name": "blue", "albedo": [0, 0, 1]}],
+      "shapes": [
+        {"type": "obj", "file": "emissive.obj", "material": "blue"},
+        {"type": "obj", "file": "emissive.obj", "emission": [1, 1, 1], "two_sided": true},
+        {"type": "quad", "corner": [0, 5, 0], "edge1": [1, 0, 0], "edge2": [0, 0, 1],
+         "emission": 2}])",
+                                "[]"));
+  ASSERT_EQ(s.triangle_count(), 4u + 4u + 2u);
+  // Override: every triangle "blue" (index 2), but Ke still makes the lamp emit.
+  for (size_t t = 0; t < 4; ++t)
+    EXPECT_EQ(s.triangle_material[t], 2);
+  // No override: the scene's "grey" wins over the MTL's grey; "lamp" comes from the MTL.
+  EXPECT_EQ(s.triangle_material[7], 1);
+  EXPECT_EQ(s.materials[size_t(s.triangle_material[4])].name, "lamp");
+  // emission in the scene: every non-degenerate triangle of the second OBJ emits 1, two-sided.
+  EXPECT_EQ(s.lights.size(), 2u + 3u + 2u);
+  const Light& l = s.lights[2];
+  EXPECT_FLOAT_EQ(l.emission.x, 1.0f);
+  EXPECT_EQ(l.flags, LIGHT_FLAG_FROM_MESH | LIGHT_FLAG_TWO_SIDED);
+  EXPECT_EQ(s.triangle_light[7], 4); // the floor triangle of the second OBJ
+  EXPECT_FLOAT_EQ(s.lights.back().emission.y, 2.0f);
+  EXPECT_EQ(s.triangle_light[9], 6);
+}
+
+TEST(SceneLoader, SceneFileRelativePaths) {
+  // load_scene resolves OBJ paths against the scene file's directory.
+  Scene s = load_scene(std::filesystem::path(CANOPY_TEST_DATA_DIR) / "good_obj_scene.json");
+  EXPECT_EQ(s.triangle_count(), 4u);
+  EXPECT_EQ(s.lights.size(), 2u);
+}
