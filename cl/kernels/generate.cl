@@ -7,7 +7,8 @@
 __kernel void generate(__global const CameraParams* cam, uint seed, ulong wave_base, int count,
                        __global float4* ray_o, __global float4* ray_d,
                        __global float4* throughput, __global float4* radiance,
-                       __global uint* rng_state, __global int* ray_queue) {
+                       __global uint* rng_state, __global int* ray_queue,
+                       __global int2* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
   ulong g = wave_base + (ulong)i;
@@ -26,4 +27,5 @@ __kernel void generate(__global const CameraParams* cam, uint seed, ulong wave_b
   radiance[i] = (float4)(0.0f);
   rng_state[i] = r.state;
   ray_queue[i] = i;
+  path_counts[i] = (int2)(0, 0); // shadow rays, shading points
 }

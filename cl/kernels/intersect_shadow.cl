@@ -16,12 +16,14 @@ __kernel void intersect_shadow(__global const BvhNode* nodes, __global const int
 }
 
 __kernel void accumulate_shadow(__global const ShadowItem* items, int count,
-                                __global float4* radiance) {
+                                __global float4* radiance, __global int2* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
   int path = as_int(items[i].dir.w);
   if (i > 0 && as_int(items[i - 1].dir.w) == path) return; // not the first of its run
   float3 sum = (float3)(0.0f);
-  for (int j = i; j < count && as_int(items[j].dir.w) == path; ++j) sum += items[j].contribution.xyz;
+  int j = i;
+  for (; j < count && as_int(items[j].dir.w) == path; ++j) sum += items[j].contribution.xyz;
   radiance[path] += (float4)(sum, 0.0f);
+  path_counts[path].x += j - i;
 }

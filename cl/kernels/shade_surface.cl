@@ -16,7 +16,8 @@ __kernel void shade_surface(int depth, int max_depth, __global const int* queue,
 
 __kernel void scatter_shade(__global const int* queue, int count, SCAN_PARAMS,
                             __global int* queue_out, __global SplitItem* split_out,
-                            float4 root_sphere, float root_cv2, uint max_cut) {
+                            float4 root_sphere, float root_cv2, uint max_cut,
+                            __global int2* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
   int2 c = counts[i];
@@ -24,6 +25,7 @@ __kernel void scatter_shade(__global const int* queue, int count, SCAN_PARAMS,
   int path = queue[i];
   if (c.x) queue_out[pos.x] = path;
   if (c.y) {
+    path_counts[path].y += 1; // one shading point per path and bounce: no race
     SplitItem it;
     it.sphere = root_sphere;
     it.path = path;

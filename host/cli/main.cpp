@@ -33,7 +33,7 @@ struct RenderArgs {
   std::optional<int> spp;
   std::optional<uint32_t> seed;
   std::optional<std::string> light_sampler;
-  std::string out, png, device, stats_json;
+  std::string out, png, device, stats_json, heatmap;
   bool stats = false;
 };
 
@@ -99,6 +99,7 @@ int run_render(const RenderArgs& args) {
              {"canopy:spp", std::to_string(scene.integrator.spp)},
              {"canopy:seed", std::to_string(scene.integrator.seed)}});
   write_png(png, img);
+  if (!args.heatmap.empty()) write_png(args.heatmap, film.shadow_ray_heatmap());
   const RenderStats& st = renderer.stats();
   std::fprintf(stderr, "%s: %dx%d, %d spp, %zu lights, %zu primitives on %s\n", args.scene.c_str(),
                scene.film.width, scene.film.height, scene.integrator.spp, scene.lights.size(),
@@ -160,6 +161,8 @@ int main(int argc, char** argv) {
   render->add_option("--device", rargs.device, "OpenCL device name substring (see `canopy info`)");
   render->add_flag("--stats", rargs.stats, "Print per-stage times, throughput and cut sizes");
   render->add_option("--stats-json", rargs.stats_json, "Write the statistics as JSON to FILE");
+  render->add_option("--heatmap", rargs.heatmap,
+                     "Write a PNG heat map of shadow rays per shading point (paper Fig. 18)");
 
   CLI::App* info = app.add_subcommand("info", "List OpenCL platforms and devices");
 

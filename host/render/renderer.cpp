@@ -53,6 +53,26 @@ RgbImage Film::mean() const {
   return img;
 }
 
+RgbImage Film::shadow_ray_heatmap(float max_rays) const {
+  RgbImage img;
+  img.width = width;
+  img.height = height;
+  img.rgb.assign(size_t(width) * height * 3, 0.0f);
+  std::vector<float> v(counts.size());
+  for (size_t p = 0; p < counts.size(); ++p) v[p] = counts[p].y > 0 ? counts[p].x / counts[p].y : 0;
+  if (max_rays <= 0.0f) max_rays = std::max(1.0f, *std::max_element(v.begin(), v.end()));
+  // A perceptually ordered ramp: black -> blue -> magenta -> orange -> yellow -> white.
+  const float3 ramp[] = {{0, 0, 0}, {0.1f, 0.1f, 0.6f}, {0.7f, 0.1f, 0.6f},
+                         {1.0f, 0.5f, 0.1f}, {1.0f, 0.9f, 0.2f}, {1, 1, 1}};
+  for (size_t p = 0; p < v.size(); ++p) {
+    float x = std::clamp(v[p] / max_rays, 0.0f, 1.0f) * 5.0f;
+    int k = std::min(4, int(x));
+    float3 c = mix(ramp[k], ramp[k + 1], x - float(k));
+    img.rgb[3 * p] = c.x, img.rgb[3 * p + 1] = c.y, img.rgb[3 * p + 2] = c.z;
+  }
+  return img;
+}
+
 Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
     : rt_(rt), scene_(scene), options_(options) {
   sampler_kind_ = light_sampler_from_name(options.light_sampler);
@@ -181,9 +201,12 @@ Film Renderer::render(const RenderSettings& settings) {
   cl::Buffer nonfinite = device_buffer(ctx, sizeof(cl_int));
   cl::Buffer film_sum = device_buffer(ctx, size_t(npix) * sizeof(float4));
   cl::Buffer film_sumsq = device_buffer(ctx, size_t(npix) * sizeof(float4));
+  cl::Buffer film_counts = device_buffer(ctx, size_t(npix) * sizeof(float2));
+  cl::Buffer path_counts = device_buffer(ctx, W * sizeof(cl_int2));
   const float4 zero4 = make_float4(0, 0, 0, 0);
   q.enqueueFillBuffer(film_sum, zero4, 0, size_t(npix) * sizeof(float4));
   q.enqueueFillBuffer(film_sumsq, zero4, 0, size_t(npix) * sizeof(float4));
+  q.enqueueFillBuffer(film_counts, cl_float(0), 0, size_t(npix) * sizeof(float2));
   q.enqueueFillBuffer(nonfinite, cl_int(0), 0, sizeof(cl_int));
   q.enqueueFillBuffer(histogram, cl_int(0), 0, kCutBins * sizeof(cl_int));
 
@@ -252,6 +275,7 @@ Film Renderer::render(const RenderSettings& settings) {
     k_generate.setArg(a++, radiance);
     k_generate.setArg(a++, rng);
     k_generate.setArg(a++, queue_a);
+    k_generate.setArg(a++, path_counts);
     run("generate", k_generate, size_t(count0));
 
     cl::Buffer* q_in = &queue_a;
@@ -290,6 +314,7 @@ Film Renderer::render(const RenderSettings& settings) {
       k_scatter_shade.setArg(a++, tree_.root_sphere);
       k_scatter_shade.setArg(a++, cl_float(tree_.root_info.x));
       k_scatter_shade.setArg(a++, cl_uint(max_cut_));
+      k_scatter_shade.setArg(a++, path_counts);
       run("scatter", k_scatter_shade, size_t(count));
       stats_.shading_points += uint64_t(shade_count);
       q.enqueueFillBuffer(cut_size, cl_int(0), 0, W * sizeof(cl_int));
@@ -330,6 +355,7 @@ Film Renderer::render(const RenderSettings& settings) {
         k_shadow_sum.setArg(0, shadow);
         k_shadow_sum.setArg(1, cl_int(n_shadow));
         k_shadow_sum.setArg(2, radiance);
+        k_shadow_sum.setArg(3, path_counts);
         run("accumulate_shadow", k_shadow_sum, size_t(n_shadow));
         stats_.shadow_rays += uint64_t(n_shadow);
         std::swap(s_in, s_out);
@@ -356,6 +382,8 @@ Film Renderer::render(const RenderSettings& settings) {
     k_accumulate.setArg(a++, film_sum);
     k_accumulate.setArg(a++, film_sumsq);
     k_accumulate.setArg(a++, nonfinite);
+    k_accumulate.setArg(a++, path_counts);
+    k_accumulate.setArg(a++, film_counts);
     run("accumulate", k_accumulate, size_t(npix));
     q.finish();
     for (auto& [stage, ev] : events) stats_.stages[stage].seconds += event_seconds(ev);
@@ -369,6 +397,8 @@ Film Renderer::render(const RenderSettings& settings) {
   film.height = height;
   film.sum.resize(size_t(npix));
   film.sumsq.resize(size_t(npix));
+  film.counts.resize(size_t(npix));
+  q.enqueueReadBuffer(film_counts, CL_TRUE, 0, size_t(npix) * sizeof(float2), film.counts.data());
   q.enqueueReadBuffer(film_sum, CL_TRUE, 0, size_t(npix) * sizeof(float4), film.sum.data());
   q.enqueueReadBuffer(film_sumsq, CL_TRUE, 0, size_t(npix) * sizeof(float4), film.sumsq.data());
   cl_int nf = 0;

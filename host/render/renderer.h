@@ -45,7 +45,11 @@ struct RenderStats {
 struct Film {
   int width = 0, height = 0;
   std::vector<float4> sum, sumsq;
+  std::vector<float2> counts; // per pixel: (shadow rays, shading points), summed over samples
   RgbImage mean() const;
+  // Shadow rays per shading point in each pixel, mapped through a false-colour ramp from 0 to
+  // `max_rays` (0: the image's maximum) -- Conty Estevez & Kulla 2018, Fig. 18.
+  RgbImage shadow_ray_heatmap(float max_rays = 0.0f) const;
 };
 
 struct RenderSettings {
