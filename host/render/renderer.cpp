@@ -1,6 +1,5 @@
 #include "render/renderer.h"
 
-#include "lighttree/light_sampler.h"
 #include "render/camera.h"
 
 #include <fmt/format.h>
@@ -39,6 +38,8 @@ constexpr int kCutBins = 65;
 
 } // namespace
 
+const std::vector<std::string>& wavefront_kernel_files() { return kKernelFiles; }
+
 RgbImage Film::mean() const {
   RgbImage img;
   img.width = width;
@@ -75,35 +76,12 @@ RgbImage Film::shadow_ray_heatmap(float max_rays) const {
 
 Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
     : rt_(rt), scene_(scene), options_(options) {
-  sampler_kind_ = light_sampler_from_name(options.light_sampler);
-  const bool splits = sampler_kind_ == SAMPLER_TREE_SPLIT || sampler_kind_ == SAMPLER_EXHAUSTIVE;
-  const uint32_t n_lights = uint32_t(scene.lights.size());
-  if (sampler_kind_ == SAMPLER_EXHAUSTIVE)
-    max_cut_ = std::max<uint32_t>(1, n_lights); // every light: the budget never binds
-  else if (sampler_kind_ == SAMPLER_TREE_SPLIT)
-    max_cut_ = uint32_t(std::clamp(options.max_cut, 1, int(std::max<uint32_t>(1, n_lights))));
-  else
-    max_cut_ = 1;
-  (void)splits;
-
   auto t0 = Clock::now();
   for (const MaterialDesc& m : scene.materials) materials_.push_back(m.gpu);
   geometry_ = build_scene_geometry(scene, materials_);
-  auto t1 = Clock::now();
-  const bool uses_tree = sampler_kind_ >= SAMPLER_TREE;
-  if (uses_tree) tree_ = build_light_tree(scene.lights);
-  stats_.light_tree_seconds = seconds_since(t1);
-  std::vector<float> power_pmf, alias_prob;
-  std::vector<int> alias_index;
-  if (sampler_kind_ == SAMPLER_POWER) {
-    std::vector<EmitterBounds> eb = emitter_bounds(scene.lights);
-    std::vector<double> w(eb.size());
-    for (size_t i = 0; i < eb.size(); ++i) w[i] = eb[i].energy;
-    AliasTable table(w);
-    power_pmf = table.pmfs();
-    alias_prob = table.thresholds();
-    alias_index = table.aliases();
-  }
+  sampler_ = make_light_sampler_data(scene.lights, options.light_sampler, options.split_threshold,
+                                     options.max_cut);
+  stats_.light_tree_seconds = sampler_.tree_build_seconds;
   stats_.build_seconds = seconds_since(t0);
 
   t0 = Clock::now();
@@ -116,18 +94,18 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
   camera_ = upload(ctx, cam);
-  power_pmf_ = upload(ctx, power_pmf);
-  alias_prob_ = upload(ctx, alias_prob);
-  alias_index_ = upload(ctx, alias_index);
-  lt_nodes_ = upload(ctx, tree_.nodes);
-  lt_children_ = upload(ctx, tree_.children);
-  lt_leaf_lights_ = upload(ctx, tree_.leaf_lights);
-  lt_trails_ = upload(ctx, tree_.trails);
+  power_pmf_ = upload(ctx, sampler_.power_pmf);
+  alias_prob_ = upload(ctx, sampler_.alias_prob);
+  alias_index_ = upload(ctx, sampler_.alias_index);
+  lt_nodes_ = upload(ctx, sampler_.tree.nodes);
+  lt_children_ = upload(ctx, sampler_.tree.children);
+  lt_leaf_lights_ = upload(ctx, sampler_.tree.leaf_lights);
+  lt_trails_ = upload(ctx, sampler_.tree.trails);
   stats_.upload_seconds = seconds_since(t0);
 
   t0 = Clock::now();
-  KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_kind_)
-                                                 : scene_features(scene, sampler_kind_);
+  KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_.kind)
+                                                 : scene_features(scene, sampler_.kind);
   stats_.kernel_options = features.build_options();
   program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
@@ -153,10 +131,10 @@ int Renderer::set_light_sampler_args(cl::Kernel& k, int i) const {
   k.setArg(i++, lt_children_);
   k.setArg(i++, lt_leaf_lights_);
   k.setArg(i++, lt_trails_);
-  k.setArg(i++, tree_.root_sphere);
-  k.setArg(i++, tree_.root_info);
-  k.setArg(i++, cl_float(options_.split_threshold));
-  k.setArg(i++, cl_uint(max_cut_));
+  k.setArg(i++, sampler_.tree.root_sphere);
+  k.setArg(i++, sampler_.tree.root_info);
+  k.setArg(i++, cl_float(sampler_.threshold));
+  k.setArg(i++, cl_uint(sampler_.max_cut));
   return i;
 }
 
@@ -167,11 +145,11 @@ Film Renderer::render(const RenderSettings& settings) {
   const int width = scene_.film.width, height = scene_.film.height;
   const int npix = width * height;
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
-  // Every path's cut has at most max_cut_ items in any pass, so waves of
-  // split_queue_items / max_cut_ paths bound the split queue.
-  size_t wave = std::max<size_t>(1, std::min(settings.wave_size, options_.split_queue_items / max_cut_));
+  // Every path's cut has at most max_cut items in any pass, so waves of
+  // split_queue_items / max_cut paths bound the split queue.
+  size_t wave = std::max<size_t>(1, std::min(settings.wave_size, options_.split_queue_items / sampler_.max_cut));
   const size_t W = size_t(std::min<uint64_t>(total, wave));
-  const size_t split_cap = W * max_cut_;
+  const size_t split_cap = W * sampler_.max_cut;
   const int max_depth = scene_.integrator.max_depth;
 
   // Path state (struct of arrays) and queues, sized for one wave.
@@ -311,9 +289,9 @@ Film Renderer::render(const RenderSettings& settings) {
       a = scan_args(k_scatter_shade, a, counts_shade);
       k_scatter_shade.setArg(a++, *q_out);
       k_scatter_shade.setArg(a++, split_a);
-      k_scatter_shade.setArg(a++, tree_.root_sphere);
-      k_scatter_shade.setArg(a++, cl_float(tree_.root_info.x));
-      k_scatter_shade.setArg(a++, cl_uint(max_cut_));
+      k_scatter_shade.setArg(a++, sampler_.tree.root_sphere);
+      k_scatter_shade.setArg(a++, cl_float(sampler_.tree.root_info.x));
+      k_scatter_shade.setArg(a++, cl_uint(sampler_.max_cut));
       k_scatter_shade.setArg(a++, path_counts);
       run("scatter", k_scatter_shade, size_t(count));
       stats_.shading_points += uint64_t(shade_count);

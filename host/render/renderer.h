@@ -9,6 +9,7 @@
 #include "image/image_io.h"
 #include "lighttree/light_tree.h"
 #include "render/features.h"
+#include "render/light_sampler_data.h"
 #include "scene/scene.h"
 
 #include <cstdint>
@@ -67,6 +68,9 @@ struct RendererOptions {
   size_t split_queue_items = 1 << 20; // split-queue capacity per wave
 };
 
+// The kernel sources of the wavefront, in build order.
+const std::vector<std::string>& wavefront_kernel_files();
+
 class Renderer {
 public:
   // Builds the geometry and uploads it; compiles the kernels. `scene` lights get their `prim`
@@ -83,9 +87,7 @@ private:
   SceneGeometry geometry_;
   std::vector<Material> materials_;
   RendererOptions options_;
-  int sampler_kind_ = 0;
-  uint32_t max_cut_ = 1;
-  LightTree tree_;
+  LightSamplerData sampler_;
   RenderStats stats_;
   cl::Program program_;
   cl::Buffer nodes_, prim_index_, prims_, materials_buf_, lights_, camera_;

@@ -1,0 +1,55 @@
+#include "render/light_sampler_data.h"
+
+#include "lighttree/light_sampler.h"
+#include "render/features.h"
+
+#include <algorithm>
+#include <chrono>
+
+namespace canopy {
+
+LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const std::string& name,
+                                         float split_threshold, int max_cut) {
+  LightSamplerData d;
+  d.kind = light_sampler_from_name(name);
+  d.threshold = split_threshold;
+  const uint32_t n = uint32_t(lights.size());
+  if (d.kind == SAMPLER_EXHAUSTIVE) {
+    d.threshold = 1.0f;                 // split every cluster ...
+    d.max_cut = std::max<uint32_t>(1, n); // ... with a budget that never binds
+  } else if (d.kind == SAMPLER_TREE_SPLIT) {
+    d.max_cut = uint32_t(std::clamp(max_cut, 1, int(std::max<uint32_t>(1, n))));
+  }
+  if (d.kind >= SAMPLER_TREE) {
+    auto t0 = std::chrono::steady_clock::now();
+    d.tree = build_light_tree(lights);
+    d.tree_build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  if (d.kind == SAMPLER_POWER) {
+    std::vector<EmitterBounds> eb = emitter_bounds(lights);
+    std::vector<double> w(eb.size());
+    for (size_t i = 0; i < eb.size(); ++i) w[i] = eb[i].energy;
+    AliasTable table(w);
+    d.power_pmf = table.pmfs();
+    d.alias_prob = table.thresholds();
+    d.alias_index = table.aliases();
+  }
+  return d;
+}
+
+LightSamplerCtx LightSamplerData::host_view(const std::vector<Light>& lights) const {
+  LightSamplerCtx ls{};
+  ls.kind = kind;
+  ls.light_count = int(lights.size());
+  ls.lights = lights.data();
+  ls.power_pmf = power_pmf.data();
+  ls.alias_prob = alias_prob.data();
+  ls.alias_index = alias_index.data();
+  ls.tree = tree.view(lights.data());
+  ls.threshold = threshold;
+  ls.max_cut = max_cut;
+  return ls;
+}
+
+} // namespace canopy
