@@ -1,0 +1,558 @@
+// Every wavefront kernel on PoCL against a host reference on identical inputs: generate,
+// shade_surface (+ scatter_shade), light_pick (+ scatter_split) for every light sampler, with and
+// without splitting, accumulate_shadow, accumulate, cut_histogram and the scan. The intersect
+// kernels are checked against Embree in test_intersect_embree.cpp.
+//
+// shade_surface and light_pick run the per-item functions of cl/integrator/ on both sides, so
+// these tests prove the device executes them as the host does (address spaces, struct layouts,
+// argument order, compiler); their statistical correctness is proven on the host by
+// test_light_tree_* and end to end by test_render_analytic. generate and accumulate have
+// independent references written here.
+#include "accel/bvh.h"
+#include "cl/runtime.h"
+#include "integrator/light_pick.h"
+#include "integrator/shade_surface.h"
+#include "render/camera.h"
+#include "render/features.h"
+#include "render/light_sampler_data.h"
+#include "render/renderer.h"
+#include "rng.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace canopy;
+
+namespace {
+
+// A box room lit by every light type: point, spot, sphere, quad, triangle, an emissive quad
+// shape (mesh-light triangles) and 300 random points, so the light tree has several levels.
+const char* kSceneJson = R"({
+  "camera": { "position": [0, 1.5, 5], "look_at": [0, 1, 0], "up": [0, 1, 0], "fov": 50 },
+  "film": { "width": 16, "height": 12 },
+  "integrator": { "spp": 1, "max_depth": 3 },
+  "materials": [ { "name": "white", "albedo": 0.7 }, { "name": "red", "albedo": [0.7, 0.1, 0.1] } ],
+  "shapes": [
+    { "type": "box", "material": "white", "min": [-3, 0, -3], "max": [3, 3, 3] },
+    { "type": "box", "material": "red", "min": [-0.5, 0, -0.5], "max": [0.5, 1, 0.5], "rotate_y": 30 },
+    { "type": "quad", "corner": [-1, 2.9, -1], "edge1": [2, 0, 0], "edge2": [0, 0, 0.2],
+      "emission": [4, 4, 4] }
+  ],
+  "lights": [
+    { "type": "point", "position": [0, 2.5, 0], "intensity": [5, 5, 5] },
+    { "type": "spot", "position": [-2, 2.5, 1], "direction": [1, -1, 0], "intensity": 20,
+      "cone_angle": 35, "falloff_start": 25 },
+    { "type": "sphere", "center": [2, 0.3, 1], "radius": 0.3, "radiance": [8, 6, 3] },
+    { "type": "quad", "corner": [-1, 2.95, 1], "edge1": [2, 0, 0], "edge2": [0, 0, 0.5], "radiance": 3 },
+    { "type": "triangle", "v0": [-2.5, 0.01, -2.5], "v1": [-1.5, 0.01, -2.5], "v2": [-2.5, 0.01, -1.5],
+      "radiance": [0, 0, 10], "two_sided": true }
+  ],
+  "light_sets": [
+    { "type": "random_box", "min": [-2.5, 2.0, -2.5], "max": [2.5, 2.8, 2.5], "count": 300, "seed": 3,
+      "light": { "type": "point", "intensity": 0.05 } }
+  ]
+})";
+
+constexpr int kPaths = 4096;
+
+template <class T> cl::Buffer to_device(ClRuntime& rt, const std::vector<T>& v) {
+  size_t bytes = std::max<size_t>(1, v.size()) * sizeof(T);
+  if (v.empty()) return cl::Buffer(rt.context(), CL_MEM_READ_WRITE, bytes);
+  return cl::Buffer(rt.context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(v.data()));
+}
+template <class T> std::vector<T> from_device(ClRuntime& rt, const cl::Buffer& b, size_t n) {
+  std::vector<T> v(n);
+  if (n) rt.queue().enqueueReadBuffer(b, CL_TRUE, 0, n * sizeof(T), v.data());
+  return v;
+}
+
+// Floats that went through device math (sqrt, sin, cos, division may differ by an ulp or two
+// from glibc) are compared relatively; everything discrete must match exactly.
+void expect_close(float a, float b, const std::string& what) {
+  float tol = 2e-5f * std::max({1.0f, std::fabs(a), std::fabs(b)});
+  EXPECT_NEAR(a, b, tol) << what;
+}
+void expect_close4(float4 a, float4 b, const std::string& what) {
+  expect_close(a.x, b.x, what + ".x");
+  expect_close(a.y, b.y, what + ".y");
+  expect_close(a.z, b.z, what + ".z");
+  expect_close(a.w, b.w, what + ".w");
+}
+
+// Host copies of the path state, uploaded identically to the device.
+struct Paths {
+  std::vector<float4> ray_o, ray_d, throughput, radiance, shade_P, shade_N, shade_f;
+  std::vector<uint32_t> rng;
+  std::vector<Hit> hits;
+  PathBuffers host() {
+    return PathBuffers{ray_o.data(),   ray_d.data(),   throughput.data(), radiance.data(), rng.data(),
+                       hits.data(),    shade_P.data(), shade_N.data(),    shade_f.data()};
+  }
+};
+
+class KernelStages : public ::testing::TestWithParam<std::string> {
+protected:
+  void SetUp() override {
+    scene_ = load_scene_from_string(kSceneJson, "kernel-test.json", ".");
+    for (const MaterialDesc& m : scene_.materials) materials_.push_back(m.gpu);
+    geometry_ = build_scene_geometry(scene_, materials_);
+    sampler_ = make_light_sampler_data(scene_.lights, GetParam(), 0.85f, 16);
+    program_ = rt_.build_program(wavefront_kernel_files(),
+                                 KernelFeatures::all(sampler_.kind).build_options());
+  }
+
+  // Random paths: rays from random points in the room to random directions, their closest hits
+  // (host traversal), random throughput and radiance, depth-dependent MIS context.
+  Paths make_paths(uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    Paths p;
+    for (int i = 0; i < kPaths; ++i) {
+      float3 o = make_float3(-2.8f + 5.6f * u(rng), 0.1f + 2.8f * u(rng), -2.8f + 5.6f * u(rng));
+      float z = 2 * u(rng) - 1, phi = 6.2831853f * u(rng), s = std::sqrt(std::max(0.0f, 1 - z * z));
+      float3 d = make_float3(s * std::cos(phi), z, s * std::sin(phi));
+      Hit h;
+      bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(), geometry_.prims.data(), o, d,
+                    0.0f, FLT_INF, 0, &h);
+      p.ray_o.push_back(f4_from3(o, 0));
+      p.ray_d.push_back(f4_from3(d, 0));
+      p.hits.push_back(h);
+      p.throughput.push_back(make_float4(0.2f + u(rng), 0.2f + u(rng), 0.2f + u(rng), 0));
+      p.radiance.push_back(make_float4(u(rng), u(rng), u(rng), 0));
+      p.rng.push_back(uint32_t(rng()));
+      // Previous vertex: a point in the room, a normal, and the pdf of the BSDF ray (0: none).
+      p.shade_P.push_back(make_float4(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng), i % 3 == 0 ? 0.0f : u(rng)));
+      p.shade_N.push_back(f4_from3(normalize(make_float3(u(rng) - 0.5f, 1.0f, u(rng) - 0.5f)), 0));
+      p.shade_f.push_back(make_float4(0, 0, 0, 0));
+    }
+    return p;
+  }
+
+  struct DevicePaths {
+    cl::Buffer ray_o, ray_d, throughput, radiance, rng, hits, shade_P, shade_N, shade_f;
+  };
+  DevicePaths upload(const Paths& p) {
+    return {to_device(rt_, p.ray_o),   to_device(rt_, p.ray_d),   to_device(rt_, p.throughput),
+            to_device(rt_, p.radiance), to_device(rt_, p.rng),     to_device(rt_, p.hits),
+            to_device(rt_, p.shade_P),  to_device(rt_, p.shade_N), to_device(rt_, p.shade_f)};
+  }
+  Paths download(const DevicePaths& d) {
+    Paths p;
+    p.ray_o = from_device<float4>(rt_, d.ray_o, kPaths);
+    p.ray_d = from_device<float4>(rt_, d.ray_d, kPaths);
+    p.throughput = from_device<float4>(rt_, d.throughput, kPaths);
+    p.radiance = from_device<float4>(rt_, d.radiance, kPaths);
+    p.rng = from_device<uint32_t>(rt_, d.rng, kPaths);
+    p.hits = from_device<Hit>(rt_, d.hits, kPaths);
+    p.shade_P = from_device<float4>(rt_, d.shade_P, kPaths);
+    p.shade_N = from_device<float4>(rt_, d.shade_N, kPaths);
+    p.shade_f = from_device<float4>(rt_, d.shade_f, kPaths);
+    return p;
+  }
+  int set_path_args(cl::Kernel& k, int i, const DevicePaths& d) {
+    for (const cl::Buffer* b : {&d.ray_o, &d.ray_d, &d.throughput, &d.radiance, &d.rng, &d.hits, &d.shade_P,
+                                &d.shade_N, &d.shade_f})
+      k.setArg(i++, *b);
+    return i;
+  }
+  int set_scene_args(cl::Kernel& k, int i) {
+    k.setArg(i++, buf_nodes_);
+    k.setArg(i++, buf_prim_index_);
+    k.setArg(i++, buf_prims_);
+    k.setArg(i++, buf_materials_);
+    k.setArg(i++, cl_float(geometry_.ray_eps));
+    return i;
+  }
+  int set_sampler_args(cl::Kernel& k, int i) {
+    k.setArg(i++, cl_int(scene_.lights.size()));
+    k.setArg(i++, buf_lights_);
+    k.setArg(i++, buf_power_pmf_);
+    k.setArg(i++, buf_alias_prob_);
+    k.setArg(i++, buf_alias_index_);
+    k.setArg(i++, buf_lt_nodes_);
+    k.setArg(i++, buf_lt_children_);
+    k.setArg(i++, buf_lt_leaf_);
+    k.setArg(i++, buf_lt_trails_);
+    k.setArg(i++, sampler_.tree.root_sphere);
+    k.setArg(i++, sampler_.tree.root_info);
+    k.setArg(i++, cl_float(sampler_.threshold));
+    k.setArg(i++, cl_uint(sampler_.max_cut));
+    return i;
+  }
+  void upload_scene() {
+    buf_nodes_ = to_device(rt_, geometry_.bvh.nodes);
+    buf_prim_index_ = to_device(rt_, geometry_.bvh.prim_index);
+    buf_prims_ = to_device(rt_, geometry_.prims);
+    buf_materials_ = to_device(rt_, materials_);
+    buf_lights_ = to_device(rt_, scene_.lights);
+    buf_power_pmf_ = to_device(rt_, sampler_.power_pmf);
+    buf_alias_prob_ = to_device(rt_, sampler_.alias_prob);
+    buf_alias_index_ = to_device(rt_, sampler_.alias_index);
+    buf_lt_nodes_ = to_device(rt_, sampler_.tree.nodes);
+    buf_lt_children_ = to_device(rt_, sampler_.tree.children);
+    buf_lt_leaf_ = to_device(rt_, sampler_.tree.leaf_lights);
+    buf_lt_trails_ = to_device(rt_, sampler_.tree.trails);
+  }
+  SceneBuffers host_scene() {
+    return SceneBuffers{geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(), geometry_.prims.data(),
+                        materials_.data(), geometry_.ray_eps};
+  }
+
+  ClRuntime rt_;
+  Scene scene_;
+  std::vector<Material> materials_;
+  SceneGeometry geometry_;
+  LightSamplerData sampler_;
+  cl::Program program_;
+  cl::Buffer buf_nodes_, buf_prim_index_, buf_prims_, buf_materials_, buf_lights_, buf_power_pmf_,
+      buf_alias_prob_, buf_alias_index_, buf_lt_nodes_, buf_lt_children_, buf_lt_leaf_, buf_lt_trails_;
+};
+
+void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& which) {
+  for (int path : which) {
+    size_t p = size_t(path);
+    std::string at = "path " + std::to_string(path);
+    expect_close4(dev.ray_o[p], ref.ray_o[p], at + " ray_o");
+    expect_close4(dev.ray_d[p], ref.ray_d[p], at + " ray_d");
+    expect_close4(dev.throughput[p], ref.throughput[p], at + " throughput");
+    expect_close4(dev.radiance[p], ref.radiance[p], at + " radiance");
+    expect_close4(dev.shade_P[p], ref.shade_P[p], at + " shade_P");
+    EXPECT_EQ(dev.rng[p], ref.rng[p]) << at;
+    expect_close(dev.shade_N[p].x, ref.shade_N[p].x, at + " N");
+    EXPECT_EQ(float_as_uint_(dev.shade_N[p].w), float_as_uint_(ref.shade_N[p].w)) << at << " seed";
+    expect_close4(dev.shade_f[p], ref.shade_f[p], at + " shade_f");
+    if (::testing::Test::HasFailure()) return; // one path's report is enough
+  }
+}
+
+} // namespace
+
+TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
+  upload_scene();
+  LightSamplerCtx ls = sampler_.host_view(scene_.lights);
+  SceneBuffers sc = host_scene();
+  Paths paths = make_paths(17);
+  std::vector<int> queue(kPaths);
+  for (int i = 0; i < kPaths; ++i) queue[size_t(i)] = (i * 7919) % kPaths; // a permutation
+  int hits = 0;
+  for (const Hit& h : paths.hits) hits += h.prim >= 0;
+  ASSERT_GT(hits, kPaths * 9 / 10);
+
+  for (int depth : {0, 1, 2}) {
+    SCOPED_TRACE("depth " + std::to_string(depth));
+    // ---- shade_surface: device
+    DevicePaths d = upload(paths);
+    cl::Buffer b_queue = to_device(rt_, queue), b_counts(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2));
+    cl::Kernel k(program_, "shade_surface");
+    int a = 0;
+    k.setArg(a++, cl_int(depth));
+    k.setArg(a++, cl_int(3));
+    k.setArg(a++, b_queue);
+    k.setArg(a++, cl_int(kPaths));
+    a = set_path_args(k, a, d);
+    a = set_scene_args(k, a);
+    a = set_sampler_args(k, a);
+    k.setArg(a++, b_counts);
+    enqueue_1d(rt_.queue(), k, kPaths);
+    std::vector<int2> dev_counts = from_device<int2>(rt_, b_counts, kPaths);
+    Paths dev = download(d);
+    // ---- host reference on the same inputs
+    Paths ref = paths;
+    PathBuffers pb = ref.host();
+    std::vector<int2> ref_counts(kPaths);
+    for (int i = 0; i < kPaths; ++i) ref_counts[size_t(i)] = shade_surface_item(queue[size_t(i)], depth, 3, &sc, &pb, &ls);
+    int continues = 0, shaded = 0, emission_hits = 0;
+    for (int i = 0; i < kPaths; ++i) {
+      ASSERT_EQ(dev_counts[size_t(i)].x, ref_counts[size_t(i)].x) << "item " << i;
+      ASSERT_EQ(dev_counts[size_t(i)].y, ref_counts[size_t(i)].y) << "item " << i;
+      continues += ref_counts[size_t(i)].x;
+      shaded += ref_counts[size_t(i)].y;
+      emission_hits += paths.hits[size_t(i)].prim >= 0 && geometry_.prims[size_t(paths.hits[size_t(i)].prim)].light >= 0;
+    }
+    compare_paths(dev, ref, queue);
+    EXPECT_GT(shaded, kPaths / 2);
+    EXPECT_GT(emission_hits, 0); // the MIS-weighted emission path is exercised
+    if (depth == 2) {
+      EXPECT_LT(continues, shaded); // Russian roulette ends some paths
+    }
+
+    // ---- light_pick passes on the shaded points: device and host, pass by pass
+    std::vector<SplitItem> items;
+    for (int i = 0; i < kPaths; ++i)
+      if (ref_counts[size_t(i)].y) items.push_back(light_sampler_root(&ls, queue[size_t(i)]));
+    DevicePaths d2 = upload(ref); // the shaded state as the next stage sees it
+    PathBuffers pb2 = ref.host();
+    int passes = 0, shadow_total = 0, split_items = 0;
+    while (!items.empty()) {
+      ASSERT_LT(passes, 40);
+      size_t n = items.size();
+      cl::Buffer b_items = to_device(rt_, items);
+      cl::Buffer b_child(rt_.context(), CL_MEM_READ_WRITE, 4 * n * sizeof(SplitItem));
+      cl::Buffer b_shadow(rt_.context(), CL_MEM_READ_WRITE, 4 * n * sizeof(ShadowItem));
+      cl::Buffer b_pc(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2));
+      std::vector<int> zeros(kPaths, 0);
+      cl::Buffer b_cut = to_device(rt_, zeros);
+      cl::Kernel kp(program_, "light_pick");
+      a = 0;
+      kp.setArg(a++, b_items);
+      kp.setArg(a++, cl_int(n));
+      a = set_path_args(kp, a, d2);
+      a = set_scene_args(kp, a);
+      a = set_sampler_args(kp, a);
+      kp.setArg(a++, b_child);
+      kp.setArg(a++, b_shadow);
+      kp.setArg(a++, b_pc);
+      kp.setArg(a++, b_cut);
+      enqueue_1d(rt_.queue(), kp, n);
+      std::vector<int2> dc = from_device<int2>(rt_, b_pc, n);
+      std::vector<SplitItem> dchild = from_device<SplitItem>(rt_, b_child, 4 * n);
+      std::vector<ShadowItem> dshadow = from_device<ShadowItem>(rt_, b_shadow, 4 * n);
+      std::vector<int> dcut = from_device<int>(rt_, b_cut, kPaths);
+
+      std::vector<SplitItem> hchild(4 * n);
+      std::vector<ShadowItem> hshadow(4 * n);
+      std::vector<int> hcut(kPaths, 0);
+      std::vector<SplitItem> next;
+      for (size_t i = 0; i < n; ++i) {
+        int4 r = light_pick_item(items[i], &ls, &sc, &pb2, &hchild[4 * i], &hshadow[4 * i]);
+        hcut[size_t(items[i].path)] += r.z;
+        ASSERT_EQ(dc[i].x, r.x) << "pass " << passes << " item " << i;
+        ASSERT_EQ(dc[i].y, r.y) << "pass " << passes << " item " << i;
+        for (int j = 0; j < r.x; ++j) {
+          const SplitItem &x = dchild[4 * i + size_t(j)], &y = hchild[4 * i + size_t(j)];
+          ASSERT_EQ(x.code, y.code);
+          ASSERT_EQ(x.path, y.path);
+          ASSERT_EQ(x.budget, y.budget);
+          expect_close4(x.sphere, y.sphere, "child sphere");
+          next.push_back(y);
+        }
+        for (int j = 0; j < r.y; ++j) {
+          const ShadowItem &x = dshadow[4 * i + size_t(j)], &y = hshadow[4 * i + size_t(j)];
+          expect_close4(x.origin, y.origin, "shadow origin");
+          expect_close(x.dir.x, y.dir.x, "shadow dir");
+          EXPECT_EQ(float_as_uint_(x.dir.w), float_as_uint_(y.dir.w)) << "shadow path";
+          expect_close4(x.contribution, y.contribution, "shadow contribution");
+        }
+        split_items += r.x;
+        shadow_total += r.y;
+      }
+      EXPECT_EQ(dcut, hcut);
+      items = next;
+      ++passes;
+    }
+    EXPECT_GT(shadow_total, shaded / 8); // enough shadow items to make the comparison meaningful
+    if (sampler_.splits()) {
+      EXPECT_GT(split_items, 0); // splitting happened
+      EXPECT_GT(passes, 1);
+    } else {
+      EXPECT_EQ(passes, 1);
+      EXPECT_EQ(split_items, 0);
+    }
+    paths = ref; // the next depth starts from the shaded state
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Samplers, KernelStages,
+                         ::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive"),
+                         [](const auto& p) {
+                           std::string s = p.param;
+                           for (char& c : s)
+                             if (c == '-') c = '_';
+                           return s;
+                         });
+
+// ---------------------------------------------------------------- generate, accumulate, scans
+
+class KernelUtilities : public ::testing::Test {
+protected:
+  void SetUp() override {
+    program_ = rt_.build_program(wavefront_kernel_files(), KernelFeatures::all(SAMPLER_UNIFORM).build_options());
+  }
+  ClRuntime rt_;
+  cl::Program program_;
+};
+
+TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
+  Camera cam;
+  cam.position = make_float3(1, 2, 3);
+  cam.look_at = make_float3(0, 0.5f, -1);
+  cam.fov_y_deg = 40;
+  const int w = 37, h = 23, n = 3000;
+  const uint64_t base = 123457; // a wave that starts mid-image, in the second pass
+  std::vector<CameraParams> cp = {make_camera_params(cam, w, h)};
+  cl::Buffer b_cam = to_device(rt_, cp);
+  std::vector<cl::Buffer> out;
+  for (size_t bytes : {sizeof(float4), sizeof(float4), sizeof(float4), sizeof(float4), sizeof(uint32_t), sizeof(int),
+                       sizeof(int2)})
+    out.emplace_back(rt_.context(), CL_MEM_READ_WRITE, n * bytes);
+  cl::Kernel k(program_, "generate");
+  int a = 0;
+  k.setArg(a++, b_cam);
+  k.setArg(a++, cl_uint(99));
+  k.setArg(a++, cl_ulong(base));
+  k.setArg(a++, cl_int(n));
+  for (cl::Buffer& b : out) k.setArg(a++, b);
+  enqueue_1d(rt_.queue(), k, n);
+  auto o = from_device<float4>(rt_, out[0], n), d = from_device<float4>(rt_, out[1], n);
+  auto rng = from_device<uint32_t>(rt_, out[4], n);
+  auto queue = from_device<int>(rt_, out[5], n);
+  // Independent reference: the pixel's jittered point on the image plane, from the camera basis.
+  float3 fwd = normalize(cam.look_at - cam.position), right = normalize(cross(fwd, cam.up));
+  float3 up = cross(right, fwd);
+  float th = std::tan(0.5f * 40.0f * float(M_PI) / 180.0f), tw = th * float(w) / float(h);
+  for (int i = 0; i < n; ++i) {
+    uint64_t g = base + uint64_t(i);
+    uint32_t pixel = uint32_t(g % uint64_t(w * h)), pass = uint32_t(g / uint64_t(w * h));
+    PathRng r = rng_seed(99, pixel, pass);
+    float jx = rng_next_float(&r), jy = rng_next_float(&r);
+    float sx = (float(pixel % w) + jx) / float(w), sy = (float(pixel / w) + jy) / float(h);
+    float3 dir = normalize(fwd + right * ((2 * sx - 1) * tw) + up * ((1 - 2 * sy) * th));
+    ASSERT_NEAR(d[size_t(i)].x, dir.x, 1e-5f) << i;
+    ASSERT_NEAR(d[size_t(i)].y, dir.y, 1e-5f) << i;
+    ASSERT_NEAR(d[size_t(i)].z, dir.z, 1e-5f) << i;
+    ASSERT_EQ(o[size_t(i)].x, 1.0f);
+    ASSERT_EQ(rng[size_t(i)], r.state) << i;
+    ASSERT_EQ(queue[size_t(i)], i);
+  }
+}
+
+TEST_F(KernelUtilities, AccumulateSumsEachPixelsSamplesInOrderAndDropsNonFinite) {
+  const int npix = 50, wave = 173; // several samples of some pixels in one wave
+  const uint64_t base = 1234;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0, 10);
+  std::vector<float4> radiance(wave);
+  std::vector<int2> counts(wave);
+  for (int i = 0; i < wave; ++i) {
+    radiance[size_t(i)] = make_float4(u(rng), u(rng), u(rng), 0);
+    counts[size_t(i)] = make_int2(i % 5, 1);
+  }
+  radiance[7].y = std::numeric_limits<float>::quiet_NaN();
+  radiance[90].z = std::numeric_limits<float>::infinity();
+  std::vector<float4> sum(npix, make_float4(1, 1, 1, 2)), sumsq(npix, make_float4(0.5f, 0.5f, 0.5f, 0));
+  std::vector<float2> fc(npix, float2{0, 0});
+  std::vector<int> nonfinite = {0};
+  cl::Buffer b_r = to_device(rt_, radiance), b_s = to_device(rt_, sum), b_q = to_device(rt_, sumsq),
+             b_n = to_device(rt_, nonfinite), b_c = to_device(rt_, counts), b_fc = to_device(rt_, fc);
+  cl::Kernel k(program_, "accumulate");
+  int a = 0;
+  k.setArg(a++, cl_ulong(base));
+  k.setArg(a++, cl_int(wave));
+  k.setArg(a++, cl_int(npix));
+  k.setArg(a++, b_r);
+  k.setArg(a++, b_s);
+  k.setArg(a++, b_q);
+  k.setArg(a++, b_n);
+  k.setArg(a++, b_c);
+  k.setArg(a++, b_fc);
+  enqueue_1d(rt_.queue(), k, npix);
+  auto dsum = from_device<float4>(rt_, b_s, npix), dsq = from_device<float4>(rt_, b_q, npix);
+  auto dfc = from_device<float2>(rt_, b_fc, npix);
+  EXPECT_EQ(from_device<int>(rt_, b_n, 1)[0], 2);
+  // Reference: visit paths in order, add into their pixel (g mod npix).
+  for (int i = 0; i < wave; ++i) {
+    size_t p = size_t((base + uint64_t(i)) % npix);
+    float4 L = radiance[size_t(i)];
+    if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) L = make_float4(0, 0, 0, 0);
+    sum[p] = make_float4(sum[p].x + L.x, sum[p].y + L.y, sum[p].z + L.z, sum[p].w + 1);
+    sumsq[p] = make_float4(sumsq[p].x + L.x * L.x, sumsq[p].y + L.y * L.y, sumsq[p].z + L.z * L.z, 0);
+    fc[p].x += float(counts[size_t(i)].x);
+    fc[p].y += float(counts[size_t(i)].y);
+  }
+  for (int p = 0; p < npix; ++p) {
+    EXPECT_EQ(dsum[size_t(p)].x, sum[size_t(p)].x) << p; // same order of additions: bit-identical
+    EXPECT_EQ(dsum[size_t(p)].y, sum[size_t(p)].y) << p;
+    EXPECT_EQ(dsum[size_t(p)].z, sum[size_t(p)].z) << p;
+    EXPECT_EQ(dsum[size_t(p)].w, sum[size_t(p)].w) << p;
+    EXPECT_EQ(dsq[size_t(p)].y, sumsq[size_t(p)].y) << p;
+    EXPECT_EQ(dfc[size_t(p)].x, fc[size_t(p)].x) << p;
+    EXPECT_EQ(dfc[size_t(p)].y, fc[size_t(p)].y) << p;
+  }
+}
+
+TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
+  // Random per-item counts -> exclusive scan (scan_blocks + scan_block_sums) -> scatter_split.
+  const int n = 5000, block = 256;
+  std::mt19937 rng(8);
+  std::vector<int2> counts(n);
+  std::vector<SplitItem> child(4 * n);
+  std::vector<ShadowItem> shadow(4 * n);
+  for (int i = 0; i < n; ++i) {
+    int c = int(rng() % 5), s = c ? 0 : int(rng() % 5);
+    counts[size_t(i)] = make_int2(c, s);
+    for (int j = 0; j < 4; ++j) {
+      child[size_t(4 * i + j)] = SplitItem{make_float4(0, 0, 0, 1), i / 3, 10 * i + j, 1u, 0.0f};
+      shadow[size_t(4 * i + j)].dir = make_float4(0, 0, 1, uint_as_float_(uint(i / 3)));
+      shadow[size_t(4 * i + j)].contribution = make_float4(float(i), float(j), 1, 0);
+    }
+  }
+  int blocks = (n + block - 1) / block;
+  cl::Buffer b_c = to_device(rt_, counts), b_off(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2)),
+             b_bs(rt_.context(), CL_MEM_READ_WRITE, size_t(blocks) * sizeof(int2)),
+             b_tot(rt_.context(), CL_MEM_READ_WRITE, 2 * sizeof(int));
+  cl::Kernel ks(program_, "scan_blocks"), kb(program_, "scan_block_sums"), kx(program_, "scatter_split");
+  ks.setArg(0, b_c);
+  ks.setArg(1, cl_int(n));
+  ks.setArg(2, cl_int(block));
+  ks.setArg(3, b_off);
+  ks.setArg(4, b_bs);
+  enqueue_1d(rt_.queue(), ks, size_t(blocks));
+  kb.setArg(0, b_bs);
+  kb.setArg(1, cl_int(blocks));
+  kb.setArg(2, b_tot);
+  enqueue_1d(rt_.queue(), kb, 1);
+  auto tot = from_device<int>(rt_, b_tot, 2);
+  std::vector<SplitItem> ref_split;
+  std::vector<ShadowItem> ref_shadow;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < counts[size_t(i)].x; ++j) ref_split.push_back(child[size_t(4 * i + j)]);
+    for (int j = 0; j < counts[size_t(i)].y; ++j) ref_shadow.push_back(shadow[size_t(4 * i + j)]);
+  }
+  ASSERT_EQ(tot[0], int(ref_split.size()));
+  ASSERT_EQ(tot[1], int(ref_shadow.size()));
+  cl::Buffer b_child = to_device(rt_, child), b_shadow = to_device(rt_, shadow),
+             b_so(rt_.context(), CL_MEM_READ_WRITE, ref_split.size() * sizeof(SplitItem)),
+             b_sh(rt_.context(), CL_MEM_READ_WRITE, ref_shadow.size() * sizeof(ShadowItem));
+  int a = 0;
+  kx.setArg(a++, cl_int(n));
+  kx.setArg(a++, b_c);
+  kx.setArg(a++, b_off);
+  kx.setArg(a++, b_bs);
+  kx.setArg(a++, cl_int(block));
+  kx.setArg(a++, b_child);
+  kx.setArg(a++, b_shadow);
+  kx.setArg(a++, b_so);
+  kx.setArg(a++, b_sh);
+  enqueue_1d(rt_.queue(), kx, size_t(n));
+  auto so = from_device<SplitItem>(rt_, b_so, ref_split.size());
+  auto sh = from_device<ShadowItem>(rt_, b_sh, ref_shadow.size());
+  for (size_t i = 0; i < so.size(); ++i) ASSERT_EQ(so[i].code, ref_split[i].code) << i;
+  for (size_t i = 0; i < sh.size(); ++i) ASSERT_EQ(sh[i].contribution.x, ref_shadow[i].contribution.x) << i;
+
+  // accumulate_shadow: each path's run of items is summed in order into its radiance.
+  const int paths = n / 3 + 1;
+  std::vector<float4> radiance(size_t(paths), make_float4(0.5f, 0, 0, 0));
+  std::vector<int2> pc(size_t(paths), make_int2(0, 0));
+  cl::Buffer b_rad = to_device(rt_, radiance), b_pc = to_device(rt_, pc);
+  cl::Kernel ka(program_, "accumulate_shadow");
+  ka.setArg(0, b_sh);
+  ka.setArg(1, cl_int(sh.size()));
+  ka.setArg(2, b_rad);
+  ka.setArg(3, b_pc);
+  enqueue_1d(rt_.queue(), ka, sh.size());
+  auto drad = from_device<float4>(rt_, b_rad, size_t(paths));
+  auto dpc = from_device<int2>(rt_, b_pc, size_t(paths));
+  std::vector<float> run_sum(size_t(paths), 0.0f);
+  std::vector<int> run_count(size_t(paths), 0);
+  for (const ShadowItem& s : ref_shadow) {
+    size_t p = float_as_uint_(s.dir.w);
+    run_sum[p] += s.contribution.x;
+    run_count[p] += 1;
+  }
+  for (int p = 0; p < paths; ++p) {
+    EXPECT_EQ(drad[size_t(p)].x, 0.5f + run_sum[size_t(p)]) << p;
+    EXPECT_EQ(dpc[size_t(p)].x, run_count[size_t(p)]) << p;
+  }
+}
