@@ -126,6 +126,7 @@ INLINE float4 operator/(float4 a, float4 b) {
   return {a.x / b.x, a.y / b.y, a.z / b.z, a.w / b.w};
 }
 INLINE float4 operator*(float4 a, float s) { return {a.x * s, a.y * s, a.z * s, a.w * s}; }
+INLINE float4 operator-(float4 a, float s) { return {a.x - s, a.y - s, a.z - s, a.w - s}; }
 INLINE float4 operator*(float s, float4 a) { return {a.x * s, a.y * s, a.z * s, a.w * s}; }
 INLINE float4 fmin(float4 a, float4 b) {
   return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z), std::fmin(a.w, b.w)};

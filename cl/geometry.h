@@ -7,12 +7,16 @@
 #include "kernel_features.h"
 #include "types.h"
 
-#define BVH_STACK_SIZE 64
+// Each 4-wide level pushes at most 3 nodes; the host limits the depth to BVH_MAX_DEPTH.
+#define BVH_MAX_DEPTH 30
+#define BVH_STACK_SIZE (3 * BVH_MAX_DEPTH + 4)
+#define BVH_EMPTY (-2147483647 - 1)
+#define BVH_MAX_LEAF 16
 
-// BvhNode packing (see types.h): interior nodes keep the left/right child indices in the w lanes
-// (right > 0); leaves keep the first primitive slot in bmin.w and -count in bmax.w.
-INLINE int bvh_node_a(BvhNode n) { return (int)float_as_uint_(n.bmin.w); }
-INLINE int bvh_node_b(BvhNode n) { return (int)float_as_uint_(n.bmax.w); }
+INLINE int bvh_is_leaf(int code) { return code < 0 && code != BVH_EMPTY; }
+INLINE int bvh_leaf_first(int code) { return (-1 - code) >> 4; }
+INLINE int bvh_leaf_count(int code) { return ((-1 - code) & 15) + 1; }
+INLINE int bvh_leaf_code(int first, int count) { return -1 - ((first << 4) | (count - 1)); }
 
 // Slab test. Returns the entry distance, or INFINITY when the ray misses [tmin, tmax].
 INLINE float ray_box(float3 o, float3 inv_d, float4 bmin, float4 bmax, float tmin, float tmax) {
@@ -77,51 +81,93 @@ INLINE int ray_primitive(const GLOBAL Primitive* prim, float3 o, float3 d, float
                       u, v);
 }
 
+// Entry distances of the ray into the four child boxes of a node (INFINITY: missed or empty).
+INLINE float4 bvh_node_entry(const GLOBAL BvhNode* n, float3 o, float3 inv_d, float tmin, float tmax) {
+  float4 tx0 = (n->min_x - o.x) * inv_d.x, tx1 = (n->max_x - o.x) * inv_d.x;
+  float4 ty0 = (n->min_y - o.y) * inv_d.y, ty1 = (n->max_y - o.y) * inv_d.y;
+  float4 tz0 = (n->min_z - o.z) * inv_d.z, tz1 = (n->max_z - o.z) * inv_d.z;
+  float4 t0 = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), make_float4(tmin, tmin, tmin, tmin)));
+  float4 t1 = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), make_float4(tmax, tmax, tmax, tmax)));
+  int4 c = n->child;
+  // 1 + 2*gamma(3) widening keeps the test conservative under rounding (pbrt-v4 §6.1.2).
+  float4 one = make_float4(1.0000004f, 1.0000004f, 1.0000004f, 1.0000004f);
+  t1 = t1 * one;
+  return make_float4(c.x != BVH_EMPTY && t0.x <= t1.x ? t0.x : FLT_INF,
+                     c.y != BVH_EMPTY && t0.y <= t1.y ? t0.y : FLT_INF,
+                     c.z != BVH_EMPTY && t0.z <= t1.z ? t0.z : FLT_INF,
+                     c.w != BVH_EMPTY && t0.w <= t1.w ? t0.w : FLT_INF);
+}
+
 // Closest hit (any_hit == 0) or first hit found (any_hit != 0) along o + t d, t in (tmin, tmax).
-// Returns the hit primitive or -1; t/u/v of the hit in *hit.
+// Returns the hit primitive or -1; t/u/v of the hit in *hit. Leaves met in a node are intersected
+// at once (shrinking tmax before the interior children are ordered); interior children are visited
+// nearest first, the others pushed with their entry distance and skipped on pop if a closer hit
+// was found meanwhile.
 INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL int* prim_index,
                          const GLOBAL Primitive* prims, float3 o, float3 d, float tmin, float tmax,
                          int any_hit, Hit* hit) {
   float3 inv_d = make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
   int stack[BVH_STACK_SIZE];
+  float stack_t[BVH_STACK_SIZE];
   int sp = 0;
   int best = -1;
   float best_u = 0.0f, best_v = 0.0f;
   int node = 0;
-  if (ray_box(o, inv_d, nodes[0].bmin, nodes[0].bmax, tmin, tmax) == FLT_INF) node = -1;
   while (node >= 0) {
-    BvhNode n = nodes[node];
-    int a = bvh_node_a(n), b = bvh_node_b(n);
-    if (b < 0) { // leaf
-      for (int i = 0; i < -b; ++i) {
-        int p = prim_index[a + i];
-        float t, u, v;
-        if (ray_primitive(&prims[p], o, d, tmin, tmax, &t, &u, &v)) {
-          tmax = t;
+    const GLOBAL BvhNode* n = &nodes[node];
+    float4 t4 = bvh_node_entry(n, o, inv_d, tmin, tmax);
+    int4 c4 = n->child;
+    int next[4];
+    float next_t[4];
+    int m = 0;
+    for (int lane = 0; lane < 4; ++lane) {
+      float t = f4_get(t4, lane);
+      int c = i4_get(c4, lane);
+      if (t == FLT_INF || !(t <= tmax)) continue; // missed or empty (tmax may be infinite)
+      if (c >= 0) {
+        // insertion by distance, nearest first
+        int k = m++;
+        while (k > 0 && next_t[k - 1] > t) {
+          next[k] = next[k - 1];
+          next_t[k] = next_t[k - 1];
+          --k;
+        }
+        next[k] = c;
+        next_t[k] = t;
+        continue;
+      }
+      int first = bvh_leaf_first(c), count = bvh_leaf_count(c);
+      for (int i = 0; i < count; ++i) {
+        int p = prim_index[first + i];
+        float th, u, v;
+        if (ray_primitive(&prims[p], o, d, tmin, tmax, &th, &u, &v)) {
+          tmax = th;
           best = p;
           best_u = u;
           best_v = v;
-          if (any_hit) {
-            sp = 0;
-            break;
-          }
+          if (any_hit) break;
         }
       }
       if (any_hit && best >= 0) break;
-      node = sp > 0 ? stack[--sp] : -1;
-      continue;
     }
-    float ta = ray_box(o, inv_d, nodes[a].bmin, nodes[a].bmax, tmin, tmax);
-    float tb = ray_box(o, inv_d, nodes[b].bmin, nodes[b].bmax, tmin, tmax);
-    if (ta == FLT_INF && tb == FLT_INF) {
-      node = sp > 0 ? stack[--sp] : -1;
-    } else if (ta == FLT_INF || tb == FLT_INF) {
-      node = ta == FLT_INF ? b : a;
-    } else { // both: visit the nearer first
-      int near_c = ta <= tb ? a : b;
-      int far_c = ta <= tb ? b : a;
-      if (sp < BVH_STACK_SIZE) stack[sp++] = far_c;
-      node = near_c;
+    if (any_hit && best >= 0) break;
+    // Visit the nearest child that is still closer than the best hit; push the others, farthest
+    // first, so the second nearest is popped next.
+    node = -1;
+    float node_t = 0.0f;
+    for (int k = m - 1; k >= 0; --k) {
+      if (!(next_t[k] <= tmax)) continue;
+      if (node >= 0) {
+        stack[sp] = node;
+        stack_t[sp] = node_t;
+        ++sp;
+      }
+      node = next[k];
+      node_t = next_t[k];
+    }
+    while (node < 0 && sp > 0) {
+      --sp;
+      if (stack_t[sp] <= tmax) node = stack[sp];
     }
   }
   hit->t = best >= 0 ? tmax : FLT_INF;

@@ -54,11 +54,13 @@ typedef struct Primitive {
   int pad;
 } Primitive;
 
-// Binary BVH node in a flat array. Interior: children at `left` and `right`. Leaf: `count` > 0
-// primitives starting at `first` in the primitive-index array.
+// 4-wide BVH node, struct of arrays: lane i of each float4 is child i's box, so one node's four
+// boxes are tested with float4 arithmetic. child[i] >= 0: an interior node; BVH_EMPTY: unused
+// lane; other negative values: a leaf of prim_index[first .. first + count), see bvh_leaf_*.
 typedef struct BvhNode {
-  float4 bmin; // xyz: box min, w: as_float(left or first)
-  float4 bmax; // xyz: box max, w: as_float(right or -count) -- see bvh_node_* accessors
+  float4 min_x, min_y, min_z;
+  float4 max_x, max_y, max_z;
+  int4 child;
 } BvhNode;
 
 // ---------------------------------------------------------------- camera

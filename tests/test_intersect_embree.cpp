@@ -78,22 +78,33 @@ std::vector<Hit> run_closest(ClRuntime& rt, cl::Program& program, const Bvh& bvh
 } // namespace
 
 TEST_F(IntersectTest, BvhIsWellFormed) {
-  ASSERT_LE(bvh_->depth, BVH_STACK_SIZE);
+  ASSERT_LE(bvh_->depth, BVH_MAX_DEPTH);
   std::vector<int> seen(prims_->size(), 0);
-  for (const BvhNode& n : bvh_->nodes) {
-    int a = bvh_node_a(n), b = bvh_node_b(n);
-    if (b < 0)
-      for (int i = 0; i < -b; ++i) seen[size_t(bvh_->prim_index[size_t(a + i)])]++;
-    else {
-      ASSERT_LT(size_t(a), bvh_->nodes.size());
-      ASSERT_LT(size_t(b), bvh_->nodes.size());
-      for (int c : {a, b}) { // child boxes inside the parent's
-        EXPECT_GE(bvh_->nodes[size_t(c)].bmin.x, n.bmin.x);
-        EXPECT_LE(bvh_->nodes[size_t(c)].bmax.z, n.bmax.z);
+  std::vector<int> parents(bvh_->nodes.size(), 0);
+  for (const BvhNode& n : bvh_->nodes)
+    for (int lane = 0; lane < 4; ++lane) {
+      int c = i4_get(n.child, lane);
+      if (c == BVH_EMPTY) continue;
+      float3 lo = make_float3(f4_get(n.min_x, lane), f4_get(n.min_y, lane), f4_get(n.min_z, lane));
+      float3 hi = make_float3(f4_get(n.max_x, lane), f4_get(n.max_y, lane), f4_get(n.max_z, lane));
+      if (c >= 0) {
+        ASSERT_LT(size_t(c), bvh_->nodes.size());
+        parents[size_t(c)]++;
+        continue;
+      }
+      for (int i = 0; i < bvh_leaf_count(c); ++i) {
+        int p = bvh_->prim_index[size_t(bvh_leaf_first(c) + i)];
+        seen[size_t(p)]++;
+        const Primitive& pr = (*prims_)[size_t(p)];
+        for (float3 v : {xyz_of(pr.v0), xyz_of(pr.v0) + xyz_of(pr.e1), xyz_of(pr.v0) + xyz_of(pr.e2)}) {
+          // the leaf's box (the lane's box) contains its triangles
+          ASSERT_TRUE(v.x >= lo.x && v.y >= lo.y && v.z >= lo.z && v.x <= hi.x && v.y <= hi.y && v.z <= hi.z);
+        }
       }
     }
-  }
   for (size_t p = 0; p < seen.size(); ++p) ASSERT_EQ(seen[p], 1) << "primitive " << p;
+  EXPECT_EQ(parents[0], 0);
+  for (size_t i = 1; i < parents.size(); ++i) ASSERT_EQ(parents[i], 1) << "node " << i;
 }
 
 TEST_F(IntersectTest, ClosestHitMatchesEmbreeAndHostTraversal) {

@@ -12,7 +12,6 @@ namespace canopy {
 
 namespace {
 
-constexpr unsigned kMaxDepth = 48; // < BVH_STACK_SIZE (cl/geometry.h)
 
 Primitive make_triangle(float3 a, float3 b, float3 c, int material, int light) {
   Primitive p{};
@@ -41,26 +40,28 @@ void primitive_bounds(const Primitive& p, float3& lo, float3& hi) {
 // Temporary tree produced by Embree's callbacks (allocated in Embree's thread-local arenas).
 struct BuildNode {
   bool leaf;
-  int count;             // leaf: primitive count
-  RTCBounds bounds[2];   // interior: child bounds
-  BuildNode* children[2];
+  int count;             // leaf: primitive count; interior: child count
+  RTCBounds bounds[4];   // interior: child bounds
+  BuildNode* children[4];
   const unsigned* ids;   // leaf: primitive ids
 };
 
-void* create_node(RTCThreadLocalAllocator alloc, unsigned int, void*) {
+void* create_node(RTCThreadLocalAllocator alloc, unsigned int count, void*) {
   auto* n = static_cast<BuildNode*>(rtcThreadLocalAlloc(alloc, sizeof(BuildNode), 16));
   *n = BuildNode{};
+  n->count = int(count);
   return n;
 }
 
 void set_children(void* node, void** children, unsigned int count, void*) {
   auto* n = static_cast<BuildNode*>(node);
-  for (unsigned i = 0; i < 2; ++i) n->children[i] = i < count ? static_cast<BuildNode*>(children[i]) : nullptr;
+  for (unsigned i = 0; i < 4; ++i) n->children[i] = i < count ? static_cast<BuildNode*>(children[i]) : nullptr;
+  n->count = int(count);
 }
 
 void set_bounds(void* node, const RTCBounds** bounds, unsigned int count, void*) {
   auto* n = static_cast<BuildNode*>(node);
-  for (unsigned i = 0; i < count && i < 2; ++i) n->bounds[i] = *bounds[i];
+  for (unsigned i = 0; i < count && i < 4; ++i) n->bounds[i] = *bounds[i];
 }
 
 void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count, void*) {
@@ -74,30 +75,73 @@ void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims,
   return n;
 }
 
-BvhNode pack_node(const RTCBounds& b, int a_lane, int b_lane) {
+RTCBounds empty_bounds() {
+  float inf = std::numeric_limits<float>::infinity();
+  return RTCBounds{inf, inf, inf, 0, -inf, -inf, -inf, 0};
+}
+
+void set_lane(BvhNode& n, int lane, const RTCBounds& b, int code) {
+  float* f[6] = {&n.min_x.x, &n.min_y.x, &n.min_z.x, &n.max_x.x, &n.max_y.x, &n.max_z.x};
+  const float v[6] = {b.lower_x, b.lower_y, b.lower_z, b.upper_x, b.upper_y, b.upper_z};
+  for (int k = 0; k < 6; ++k) f[k][lane] = v[k];
+  (&n.child.x)[lane] = code;
+}
+
+BvhNode empty_node() {
   BvhNode n;
-  n.bmin = make_float4(b.lower_x, b.lower_y, b.lower_z, uint_as_float_(uint(a_lane)));
-  n.bmax = make_float4(b.upper_x, b.upper_y, b.upper_z, uint_as_float_(uint(b_lane)));
+  for (int lane = 0; lane < 4; ++lane) set_lane(n, lane, empty_bounds(), BVH_EMPTY);
   return n;
 }
 
-// Depth-first flatten; the node for `src` has already been reserved at index `at`.
-void flatten(const BuildNode* src, const RTCBounds& box, int at, int depth, Bvh& out) {
-  out.depth = std::max(out.depth, depth);
-  if (src->leaf) {
-    int first = int(out.prim_index.size());
-    for (int i = 0; i < src->count; ++i) out.prim_index.push_back(int(src->ids[i]));
-    out.nodes[at] = pack_node(box, first, -src->count);
-    return;
+struct Flattener {
+  const std::vector<Primitive>& prims;
+  Bvh& out;
+
+  RTCBounds bounds_of(const unsigned* ids, int count) const {
+    RTCBounds b = empty_bounds();
+    for (int i = 0; i < count; ++i) {
+      float3 lo, hi;
+      primitive_bounds(prims[ids[i]], lo, hi);
+      b.lower_x = std::min(b.lower_x, lo.x), b.lower_y = std::min(b.lower_y, lo.y);
+      b.lower_z = std::min(b.lower_z, lo.z), b.upper_x = std::max(b.upper_x, hi.x);
+      b.upper_y = std::max(b.upper_y, hi.y), b.upper_z = std::max(b.upper_z, hi.z);
+    }
+    return b;
   }
-  int left = int(out.nodes.size());
-  out.nodes.emplace_back();
-  int right = int(out.nodes.size());
-  out.nodes.emplace_back();
-  out.nodes[at] = pack_node(box, left, right);
-  flatten(src->children[0], src->bounds[0], left, depth + 1, out);
-  flatten(src->children[1], src->bounds[1], right, depth + 1, out);
-}
+
+  // A leaf's code; leaves over BVH_MAX_LEAF primitives (Embree makes them only at its depth limit)
+  // become a small subtree of nodes.
+  int leaf(const unsigned* ids, int count, int depth) {
+    if (count <= BVH_MAX_LEAF) {
+      int first = int(out.prim_index.size());
+      for (int i = 0; i < count; ++i) out.prim_index.push_back(int(ids[i]));
+      return bvh_leaf_code(first, count);
+    }
+    int at = int(out.nodes.size());
+    out.nodes.push_back(empty_node());
+    out.depth = std::max(out.depth, depth + 1);
+    int per = (count + 3) / 4;
+    for (int lane = 0, start = 0; lane < 4 && start < count; ++lane, start += per) {
+      int c = std::min(per, count - start);
+      int code = leaf(ids + start, c, depth + 1);
+      set_lane(out.nodes[size_t(at)], lane, bounds_of(ids + start, c), code);
+    }
+    return at;
+  }
+
+  // The code of `src` (a node index or a leaf code); `depth` is its node level.
+  int node(const BuildNode* src, int depth) {
+    if (src->leaf) return leaf(src->ids, src->count, depth);
+    int at = int(out.nodes.size());
+    out.nodes.push_back(empty_node());
+    out.depth = std::max(out.depth, depth + 1);
+    for (int lane = 0; lane < src->count; ++lane) {
+      int code = node(src->children[lane], depth + 1);
+      set_lane(out.nodes[size_t(at)], lane, src->bounds[lane], code);
+    }
+    return at;
+  }
+};
 
 } // namespace
 
@@ -146,21 +190,15 @@ std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& mat
 
 Bvh build_bvh(const std::vector<Primitive>& prims) {
   Bvh out;
-  if (prims.empty()) {
-    // An empty scene: one empty leaf with an inverted box that every ray misses.
-    BvhNode n;
-    float inf = std::numeric_limits<float>::infinity();
-    n.bmin = make_float4(inf, inf, inf, uint_as_float_(0));
-    n.bmax = make_float4(-inf, -inf, -inf, uint_as_float_(uint(-0)));
-    out.nodes.push_back(n);
+  if (prims.empty()) { // an empty scene: a root whose lanes are all empty
+    out.nodes.push_back(empty_node());
+    out.depth = 1;
     return out;
   }
   RTCDevice device = rtcNewDevice(nullptr);
   if (!device) throw std::runtime_error("rtcNewDevice failed");
   std::vector<RTCBuildPrimitive> bp(prims.size());
-  RTCBounds root{};
-  root.lower_x = root.lower_y = root.lower_z = std::numeric_limits<float>::infinity();
-  root.upper_x = root.upper_y = root.upper_z = -std::numeric_limits<float>::infinity();
+  RTCBounds root = empty_bounds();
   for (size_t i = 0; i < prims.size(); ++i) {
     float3 lo, hi;
     primitive_bounds(prims[i], lo, hi);
@@ -176,8 +214,8 @@ Bvh build_bvh(const std::vector<Primitive>& prims) {
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.byteSize = sizeof(args);
   args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
-  args.maxBranchingFactor = 2;
-  args.maxDepth = kMaxDepth;
+  args.maxBranchingFactor = 4;
+  args.maxDepth = BVH_MAX_DEPTH - 4; // headroom for splitting oversized leaves
   args.sahBlockSize = 1;
   args.minLeafSize = 1;
   args.maxLeafSize = 4;
@@ -198,12 +236,21 @@ Bvh build_bvh(const std::vector<Primitive>& prims) {
     rtcReleaseDevice(device);
     throw std::runtime_error("rtcBuildBVH failed");
   }
-  out.nodes.reserve(2 * prims.size());
+  out.nodes.reserve(prims.size() / 2 + 1);
   out.prim_index.reserve(prims.size());
-  out.nodes.emplace_back();
-  flatten(root_node, root, 0, 0, out);
+  Flattener f{prims, out};
+  if (root_node->leaf) { // the root is always a node: wrap a lone leaf
+    out.nodes.push_back(empty_node());
+    int code = f.leaf(root_node->ids, root_node->count, 1);
+    set_lane(out.nodes[0], 0, root, code);
+    out.depth = std::max(out.depth, 1);
+  } else {
+    f.node(root_node, 0);
+  }
   rtcReleaseBVH(bvh);
   rtcReleaseDevice(device);
+  if (out.depth > BVH_MAX_DEPTH)
+    throw std::runtime_error(fmt::format("BVH depth {} exceeds {}", out.depth, BVH_MAX_DEPTH));
   return out;
 }
 

@@ -1,5 +1,5 @@
 // Geometry acceleration: the primitives of a scene (its triangles plus the shapes of analytic area
-// lights), a binary BVH over them built by Embree's rtcBuildBVH (SAH) and flattened for the
+// lights), a 4-wide BVH over them built by Embree's rtcBuildBVH (SAH) and flattened for the
 // intersect kernels, and an Embree RTCScene used as the reference intersector in tests/benchmarks.
 #pragma once
 
@@ -15,7 +15,7 @@ namespace canopy {
 struct Bvh {
   std::vector<BvhNode> nodes;   // nodes[0] is the root
   std::vector<int> prim_index;  // leaf slots -> primitive index
-  int depth = 0;                // longest root-to-leaf path (<= BVH_STACK_SIZE)
+  int depth = 0;                // node levels on the longest path (<= BVH_MAX_DEPTH)
 };
 
 struct SceneGeometry {
@@ -30,8 +30,8 @@ struct SceneGeometry {
 // own triangle). Analytic light shapes use an extra black material appended to the list.
 std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& materials);
 
-// SAH BVH over `prims`, via rtcBuildBVH; depth limited so the kernels' fixed stack never
-// overflows.
+// 4-wide SAH BVH over `prims`, via rtcBuildBVH; depth limited (BVH_MAX_DEPTH) so the kernels'
+// fixed traversal stack never overflows.
 Bvh build_bvh(const std::vector<Primitive>& prims);
 
 SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& materials);
