@@ -2,8 +2,12 @@
 //   canopy render SCENE [--spp N] [--out FILE.exr] [--png FILE.png] [--seed S]
 //                       [--light-sampler NAME] [--device NAME]
 //   canopy info
+//   canopy compare A.exr B.exr      (cli/compare_command.cpp)
+//   canopy converge SCENE ...       (cli/converge_command.cpp)
 // Exit codes: 0 success, 2 invalid input (scene or arguments), 1 runtime failure.
 #include "cl/runtime.h"
+#include "cli/compare_command.h"
+#include "cli/converge_command.h"
 #include "image/image_io.h"
 #include "render/renderer.h"
 #include "render/stats_report.h"
@@ -165,6 +169,9 @@ int main(int argc, char** argv) {
                      "Write a PNG heat map of shadow rays per shading point (paper Fig. 18)");
 
   CLI::App* info = app.add_subcommand("info", "List OpenCL platforms and devices");
+  std::function<int()> action; // set by the subcommands defined in their own files
+  add_compare_command(app, action);
+  add_converge_command(app, action);
 
   try {
     app.parse(argc, argv);
@@ -180,6 +187,7 @@ int main(int argc, char** argv) {
   try {
     if (render->parsed()) return run_render(rargs);
     if (info->parsed()) return run_info();
+    if (action) return action();
   } catch (const SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;

@@ -1,0 +1,329 @@
+#!/usr/bin/env python3
+"""Writes docs/results.md (to stdout) from the outputs of `canopy converge` in docs/results/:
+<scene>.csv, <scene>-median.csv, <scene>-configs.csv, <scene>-reference.json and the PNGs.
+Run by scripts/make-results.sh; standard library only.
+
+Equal-time error: each configuration's median curve (RMSE against render seconds) is interpolated
+in log-log; outside its measured range it is extended with the Monte Carlo rate RMSE ~ t^-1/2 from
+the nearest end (marked with *).
+"""
+import argparse
+import csv
+import datetime
+import json
+import math
+import os
+import platform
+import subprocess
+
+SCENES = [
+    ("spiral-10k", "Spiral of 10,000 point lights (paper Fig. 11-12)"),
+    ("cornell-1m", "Cornell box with 10^6 ceiling lights (paper Fig. 17)"),
+    ("city", "Procedural city, about 3 x 10^5 lights, one indirect bounce (paper Fig. 1 and 14)"),
+    ("mesh-light", "Toroidal mesh light, 5,120 emissive triangles (paper Fig. 6, 15, 16)"),
+]
+THRESHOLDS = ["tree-split:0.0", "tree-split:0.25", "tree-split:0.5", "tree-split:0.85", "tree-split:0.95"]
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def curve(median_rows, label, metric="rmse"):
+    pts = [(float(r["seconds"]), float(r[metric]), float(r["shadow_rays"]), int(r["spp"]))
+           for r in median_rows if r["sampler"] == label]
+    return sorted(pts)
+
+
+def rmse_at(pts, t, rate=0.5):
+    """(value, extrapolated) at time t; outside the curve value ~ t^-rate (RMSE 1/2, MSE 1)."""
+    if not pts:
+        return (math.nan, True)
+    if t <= pts[0][0]:
+        return (pts[0][1] * (pts[0][0] / t) ** rate, t < pts[0][0] * (1 - 1e-9))
+    if t >= pts[-1][0]:
+        return (pts[-1][1] * (pts[-1][0] / t) ** rate, t > pts[-1][0] * (1 + 1e-9))
+    for (t0, r0, _, _), (t1, r1, _, _) in zip(pts, pts[1:]):
+        if t <= t1:
+            f = math.log(t / t0) / math.log(t1 / t0) if t1 > t0 else 0.0
+            return (math.exp((1 - f) * math.log(r0) + f * math.log(r1)), False)
+    return (pts[-1][1], False)
+
+
+def fmt_e(v):
+    return "n/a" if v is None or math.isnan(v) else f"{v:.3e}"
+
+
+def fmt_r(v):
+    return "n/a" if v is None or math.isnan(v) else f"{v:.2f}x"
+
+
+def machine():
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} logical cores"
+
+
+def git_commit():
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+class Scene:
+    def __init__(self, docs, name):
+        self.name = name
+        self.runs = read_csv(os.path.join(docs, f"{name}.csv"))
+        self.median = read_csv(os.path.join(docs, f"{name}-median.csv"))
+        self.configs = read_csv(os.path.join(docs, f"{name}-configs.csv"))
+        self.labels = [c["sampler"] for c in self.configs]
+        self.curves = {l: curve(self.median, l) for l in self.labels}
+        ref = os.path.join(docs, f"{name}-reference.json")
+        self.reference = json.load(open(ref)) if os.path.exists(ref) else {}
+        # Equal time: the longest time every curve reaches.
+        self.t_eq = min(c[-1][0] for c in self.curves.values() if c)
+        self.eq = {l: rmse_at(c, self.t_eq) for l, c in self.curves.items()}
+        # Equal shadow rays (the paper's Fig. 12-13 axis).
+        self.ray_curves = {l: sorted((p[2], p[1], p[0], p[3]) for p in c)
+                           for l, c in self.curves.items()}
+        self.r_eq = min(c[-1][0] for c in self.ray_curves.values() if c)
+        self.eq_rays = {l: rmse_at(c, self.r_eq) for l, c in self.ray_curves.items()}
+        self.rel_curves = {l: curve(self.median, l, "relmse") for l in self.labels}
+        self.rel_eq = {l: rmse_at(c, self.t_eq, 1.0) for l, c in self.rel_curves.items()}
+
+    def ratio(self, a, b, t=None):
+        t = self.t_eq if t is None else t
+        ra, rb = rmse_at(self.curves.get(a, []), t)[0], rmse_at(self.curves.get(b, []), t)[0]
+        return ra / rb if rb else math.nan
+
+    def rays_per_point(self, label):
+        rays = sum(float(r["shadow_rays"]) for r in self.runs if r["sampler"] == label)
+        pts = sum(float(r["shading_points"]) for r in self.runs if r["sampler"] == label)
+        return rays / pts if pts else math.nan
+
+    def best_split(self):
+        cands = [l for l in THRESHOLDS if l in self.eq]
+        return min(cands, key=lambda l: self.eq[l][0]) if cands else None
+
+    def beats_everywhere(self, a, others):
+        """a's median points: is a's RMSE below every other curve at each of a's times?"""
+        worst = 0.0
+        for (t, r, _, _) in self.curves.get(a, []):
+            for o in others:
+                ro = rmse_at(self.curves.get(o, []), t)[0]
+                worst = max(worst, r / ro)
+        return worst < 1.0, worst
+
+
+def scene_section(s, clamp, seeds):
+    out = []
+    meta = s.reference.get("test", {}).get("metadata", {})
+    ref_desc = ", ".join(f"{k.split(':', 1)[1]} {v}" for k, v in sorted(meta.items())
+                         if k.split(":", 1)[1] in ("light_sampler", "split_threshold", "spp",
+                                                    "seed", "film", "render_seconds"))
+    ref_mse = float(meta.get("canopy:reference_mse", "nan"))
+    clamp = s.runs[0].get("clamp", "0") if s.runs else "0"
+    if clamp not in ("0", "", "0.0"):
+        out.append(f"**Clamped:** both images are clamped to [0, {clamp}] before measuring: the "
+                   f"emitters are in view and sub-pixel, and their anti-aliasing noise (the same "
+                   f"for every light sampler) would otherwise dominate the RMSE.\n")
+    out.append(f"![{s.name} reference](results/{s.name}.png)\n")
+    out.append(f"Reference: {ref_desc}. Its own noise, estimated from its two independent halves, "
+               f"is RMSE {fmt_e(math.sqrt(ref_mse)) if ref_mse == ref_mse else 'n/a'} "
+               f"(the floor of every curve).\n")
+    out.append(f"Equal-time RMSE at **{s.t_eq:.3g} s** of render time per image (the longest time "
+               f"every curve reaches; values marked * are extended from the curve's end with "
+               f"the t^-1/2 Monte Carlo rate):\n")
+    out.append("| configuration | RMSE | vs power | vs uniform | relMSE | vs power "
+               "| shadow rays / shading point | light tree build (s) | points (max spp) |")
+    out.append("|---|---|---|---|---|---|---|---|---|")
+    cfg = {c["sampler"]: c for c in s.configs}
+    for l in s.labels:
+        r, ex = s.eq[l]
+        c = cfg[l]
+        tree_build = float(c["light_tree_seconds"])
+        rel, rex = s.rel_eq[l]
+        relp = s.rel_eq.get("power", (math.nan, False))[0]
+        out.append(f"| {l} | {fmt_e(r)}{'*' if ex else ''} | {fmt_r(s.ratio(l, 'power'))} | "
+                   f"{fmt_r(s.ratio(l, 'uniform'))} | {fmt_e(rel)}{'*' if rex else ''} | "
+                   f"{fmt_r(rel / relp if relp else math.nan)} | {s.rays_per_point(l):.2f} | "
+                   f"{tree_build:.3f} | {len(s.curves[l])} ({c['max_spp']}) |")
+    out.append("")
+    out.append(f"At equal shadow rays ({s.r_eq:.3g} per image, the most every curve reaches): " +
+               ", ".join(f"{l} {fmt_e(s.eq_rays[l][0])}{'*' if s.eq_rays[l][1] else ''}"
+                         for l in s.labels) + ".\n")
+    out.append(f"![{s.name}: RMSE against time](results/{s.name}-time.png)\n")
+    out.append(f"![{s.name}: RMSE against shadow rays](results/{s.name}-rays.png)\n")
+    hm = os.path.join("docs", "results", f"{s.name}-heatmap.png")
+    if os.path.exists(hm):
+        out.append(f"Shadow rays per shading point, tree-split at its default threshold (paper "
+                   f"Fig. 18):\n\n![{s.name} heat map](results/{s.name}-heatmap.png)\n")
+    else:
+        out.append("Heat map: not produced (this build of `canopy render` has no `--heatmap`).\n")
+    out.append(f"Data: [`{s.name}.csv`](results/{s.name}.csv) (every render), "
+               f"[`{s.name}-median.csv`](results/{s.name}-median.csv) (medians of {seeds} seeds), "
+               f"[`{s.name}-configs.csv`](results/{s.name}-configs.csv) (build and compile "
+               f"times).\n")
+    return "\n".join(out)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--docs", default="docs/results")
+    ap.add_argument("--command", default="./scripts/make-results.sh")
+    ap.add_argument("--clamp", default="")
+    ap.add_argument("--seeds", default="3")
+    a = ap.parse_args()
+
+    scenes = {}
+    for name, _ in SCENES:
+        if os.path.exists(os.path.join(a.docs, f"{name}-median.csv")):
+            scenes[name] = Scene(a.docs, name)
+
+    o = []
+    o.append("# Results: error against render time\n")
+    o.append(f"Regenerate everything on this page (text, tables, plots) with `{a.command}` "
+             f"(about 30 minutes on 2 cores). Generated {datetime.date.today().isoformat()} at "
+             f"commit `{git_commit()}` on {machine()}, OpenCL on PoCL's CPU device.\n")
+    o.append(
+        "Method (DESIGN.md §8): `canopy converge` renders every sampler configuration at "
+        "1, 2, 4, ... spp until its budget of render seconds is spent, "
+        f"{a.seeds} seeds per point, and measures each image against a reference with "
+        "`canopy compare`'s metrics. The curves are medians over the seeds. Time is the "
+        "renderer's wall time for the image (`RenderStats::render_seconds`: kernels, queues, "
+        "host synchronisation), after one unrecorded warm-up render; scene loading, BVH and "
+        "light tree builds and kernel compilation are reported separately. The configurations' "
+        "renders interleave (level by level, seed by seed), so that load from other processes "
+        "spreads over all curves. RMSE is over all pixels and RGB channels of the linear HDR "
+        "images, unclamped except where a section says otherwise (clamping biases heavy-tailed "
+        "estimators such as uniform sampling of the spiral, whose clamped error grows with spp)"
+        +
+        "; relMSE = mean (A - B)^2 / (B^2 + 0.01). Equal-time values interpolate the median "
+        "curves in log-log. References are rendered by `canopy converge "
+        "--reference-spp` with the sampler named in each section (an unbiased estimator at "
+        "high spp, independent seeds); the exhaustive sampler would take hours per image for "
+        "10^4-10^6 lights on this machine. Films are scaled down (`--film-scale`) so that "
+        "every configuration reaches tens of spp within its budget. `tree-split:T` is adaptive "
+        "splitting with threshold T (Canopy's dimensionless split measure, DESIGN.md §4; "
+        "0 never splits).\n")
+
+    # ------------------------------------------------------------------ targets
+    o.append("## Targets (issue 5)\n")
+    o.append("| scene | target | measured | met |")
+    o.append("|---|---|---|---|")
+    s = scenes.get("spiral-10k")
+    if s:
+        best = s.best_split()
+        r_best = s.ratio(best, "power")
+        r_tree = s.ratio("tree", "power")
+        o.append(f"| spiral-10k | tree-split at its best threshold ≤ 0.5 × power (equal time) | "
+                 f"{best}: {r_best:.2f}× | {'yes' if r_best <= 0.5 else 'no'} |")
+        o.append(f"| spiral-10k | tree ≤ 0.75 × power (equal time) | {r_tree:.2f}× | "
+                 f"{'yes' if r_tree <= 0.75 else 'no'} |")
+    else:
+        o.append("| spiral-10k | | not run | no |")
+    for name in ("cornell-1m", "city"):
+        s = scenes.get(name)
+        if not s:
+            o.append(f"| {name} | tree-split beats power and uniform at every time | not run | no |")
+            continue
+        for label in ("tree-split:0.85", s.best_split()):
+            ok, worst = s.beats_everywhere(label, ["power", "uniform"])
+            o.append(f"| {name} | {label} beats power and uniform at every time on its curve | "
+                     f"worst ratio {worst:.2f}× (max over its points of its RMSE / the others') "
+                     f"| {'yes' if ok else 'no'} |")
+            if label == s.best_split():
+                break
+    o.append("")
+
+    # ------------------------------------------------------------------ claims
+    o.append("## The paper's claims\n")
+    rows = []
+    tb = [(n, sc.ratio("tree", "power")) for n, sc in scenes.items()]
+    ok = all(r < 1 for _, r in tb)
+    rows.append(("The light tree beats power sampling (Fig. 12, 16, 19)",
+                 "; ".join(f"{n}: tree/power {r:.2f}×" for n, r in tb),
+                 "reproduced" if ok and tb else ("partly" if any(r < 1 for _, r in tb) else "not reproduced"),
+                 ", ".join(f"[{n}](#{n})" for n, _ in tb)))
+    for axis, key, what in (("time", "eq", "equal render time"),
+                            ("rays", "eq_rays", "equal shadow rays")):
+        split_txt, split_ok = [], []
+        for n, sc in scenes.items():
+            eq = getattr(sc, key)
+            vals = [(l.split(":")[1], eq[l][0]) for l in THRESHOLDS if l in eq]
+            if not vals:
+                continue
+            best = min(vals, key=lambda v: v[1])
+            # "Lowers" needs a margin beyond the seed-to-seed noise of the medians (5%).
+            lowers = best[0] != "0.0" and best[1] < 0.95 * vals[0][1]
+            oversplit = best[0] != vals[-1][0]
+            split_ok.append(lowers and oversplit)
+            split_txt.append(f"{n}: " + ", ".join(f"{t} → {v:.2e}" for t, v in vals) +
+                             f" (best {best[0]}{'' if lowers or best[0] == '0.0' else ', within 5% of 0.0'}"
+                             f"{'' if oversplit else ', still falling at 0.95'})")
+        rows.append((f"Splitting lowers the error at {what} until over-splitting costs more than "
+                     "it saves (Fig. 11-13)", "RMSE by threshold: " + "; ".join(split_txt),
+                     "reproduced" if split_ok and all(split_ok) else
+                     ("partly" if any(split_ok) else "not reproduced"),
+                     "the `-time.png` plots" if axis == "time" else "the `-rays.png` plots"))
+    s = scenes.get("mesh-light")
+    if s:
+        rows.append(("The orientation term helps mesh lights (Fig. 6, 15, 16)",
+                     f"mesh-light: tree/power {s.ratio('tree', 'power'):.2f}×, tree/uniform "
+                     f"{s.ratio('tree', 'uniform'):.2f}× at equal time. The renderer has no switch "
+                     "to turn the orientation term (or SAOH) off, so its share of the gain is not "
+                     "isolated",
+                     "not measured (tree vs power only)", "[mesh-light](#mesh-light)"))
+    builds = []
+    for n, sc in scenes.items():
+        c = {x["sampler"]: x for x in sc.configs}.get("tree")
+        if c:
+            builds.append(f"{n}: {float(c['light_tree_seconds']):.3f} s")
+    rows.append(("Building the tree is cheap (similar to a BVH build, §1)",
+                 "light tree build: " + "; ".join(builds) +
+                 " (`light_tree_seconds`, 2 cores, TBB), against render times of seconds to "
+                 "minutes per image", "reproduced" if builds else "not run",
+                 "the tables' build column"))
+    o.append("| claim | measured | verdict | where |")
+    o.append("|---|---|---|---|")
+    for r in rows:
+        o.append("| " + " | ".join(r) + " |")
+    o.append("")
+
+    o.append("### Caveats\n")
+    o.append(
+        "* Times are wall-clock on a 2-core machine that may be shared; the interleaved renders "
+        "spread other load over all curves, but single points can still be slow (visible as "
+        "kinks). The equal-time tables interpolate the medians.\n"
+        "* References are high-spp renders with an unbiased sampler (named per scene), not the "
+        "exhaustive sampler; their own noise (given per scene) is a floor under every curve and "
+        "compresses ratios near the end of the best curves.\n"
+        "* Canopy's split threshold is a dimensionless measure (DESIGN.md §4), so a threshold "
+        "does not split exactly like the same number in the paper; the sweep includes 0.25 to "
+        "locate the best value between 0 and 0.5.\n"
+        "* The orientation term cannot be switched off in the renderer, so the mesh-light claim "
+        "is only tested as tree against power/uniform, not as an ablation.\n")
+
+    # ------------------------------------------------------------------ scenes
+    for name, title in SCENES:
+        o.append(f"## {name}\n")
+        o.append(f"{title}: `scenes/{name}.json`.\n")
+        if name in scenes:
+            o.append(scene_section(scenes[name], a.clamp, a.seeds))
+        else:
+            o.append("Not run (the scene file was missing when the results were generated).\n")
+    print("\n".join(o))
+
+
+if __name__ == "__main__":
+    main()

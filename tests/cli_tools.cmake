@@ -1,0 +1,103 @@
+# CLI tests of `canopy compare` and `canopy converge` (label cli). Included by tests/CMakeLists.txt
+# to register the tests; the same file, run with `cmake -DMODE=... -P cli_tools.cmake`, is the
+# test driver (so the registration and the checks stay together).
+#   MODE=compare   EXE, OIIOTOOL, DIR: two tiny EXRs made with oiiotool; output, exit codes
+#   MODE=converge  EXE, SCENE, DIR: a 2-second converge run writes the CSVs and both plots
+
+if(NOT CMAKE_SCRIPT_MODE_FILE)
+  # ------------------------------------------------------------------ registration
+  find_program(CANOPY_OIIOTOOL oiiotool)
+  if(CANOPY_OIIOTOOL)
+    add_test(NAME cli_compare
+      COMMAND ${CMAKE_COMMAND} -DMODE=compare -DEXE=$<TARGET_FILE:canopy>
+              -DOIIOTOOL=${CANOPY_OIIOTOOL} -DDIR=${CMAKE_CURRENT_BINARY_DIR}/cli_compare
+              -P ${CMAKE_CURRENT_LIST_FILE})
+    set_tests_properties(cli_compare PROPERTIES LABELS cli TIMEOUT 120)
+  endif()
+  add_test(NAME cli_converge
+    COMMAND ${CMAKE_COMMAND} -DMODE=converge -DEXE=$<TARGET_FILE:canopy>
+            -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/data/tiny_converge.json
+            -DDIR=${CMAKE_CURRENT_BINARY_DIR}/cli_converge -P ${CMAKE_CURRENT_LIST_FILE})
+  set_tests_properties(cli_converge PROPERTIES LABELS cli TIMEOUT 600)
+  return()
+endif()
+
+# -------------------------------------------------------------------- driver
+function(run_canopy expected_rc)
+  execute_process(COMMAND "${EXE}" ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                  ERROR_VARIABLE err TIMEOUT 500)
+  if(NOT rc STREQUAL "${expected_rc}")
+    message(FATAL_ERROR "canopy ${ARGN}: expected exit code ${expected_rc}, got '${rc}'\n"
+                        "stdout:\n${out}\nstderr:\n${err}")
+  endif()
+  set(out "${out}" PARENT_SCOPE)
+  set(err "${err}" PARENT_SCOPE)
+endfunction()
+
+function(expect_contains text what)
+  string(FIND "${text}" "${what}" pos)
+  if(pos EQUAL -1)
+    message(FATAL_ERROR "expected to find '${what}' in:\n${text}")
+  endif()
+endfunction()
+
+file(REMOVE_RECURSE "${DIR}")
+file(MAKE_DIRECTORY "${DIR}")
+
+if(MODE STREQUAL "compare")
+  # A = 0.5 everywhere, B = 0.25 everywhere: RMSE 0.25, relMSE 0.0625 / (0.0625 + 0.01),
+  # PSNR 10 log10(1 / 0.0625) = 12.041 dB.
+  foreach(img "a;0.5" "b;0.25")
+    list(GET img 0 name)
+    list(GET img 1 v)
+    execute_process(COMMAND "${OIIOTOOL}" --pattern "constant:color=${v},${v},${v}" 8x6 3
+                            -d float --attrib "canopy:spp" 7 -o "${DIR}/${name}.exr"
+                    RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "oiiotool failed (${rc})")
+    endif()
+  endforeach()
+  execute_process(COMMAND "${OIIOTOOL}" --pattern "constant:color=0,0,0" 4x4 3 -d float
+                          -o "${DIR}/small.exr")
+
+  run_canopy(0 compare "${DIR}/a.exr" "${DIR}/b.exr" --error-image "${DIR}/err.png")
+  expect_contains("${out}" "RMSE       2.500000e-01")
+  expect_contains("${out}" "relMSE     8.620690e-01")
+  expect_contains("${out}" "PSNR       12.041 dB")
+  expect_contains("${out}" "spp 7") # metadata read back
+  if(NOT EXISTS "${DIR}/err.png")
+    message(FATAL_ERROR "compare --error-image did not write ${DIR}/err.png")
+  endif()
+  run_canopy(0 compare "${DIR}/a.exr" "${DIR}/a.exr" --json)
+  expect_contains("${out}" "\"rmse\": 0.0")
+  expect_contains("${out}" "\"psnr\": \"inf\"")
+  # Invalid input: exit code 2 and one line naming the file.
+  run_canopy(2 compare "${DIR}/a.exr" "${DIR}/missing.exr")
+  expect_contains("${err}" "${DIR}/missing.exr: cannot read image")
+  run_canopy(2 compare "${DIR}/a.exr" "${DIR}/small.exr")
+  expect_contains("${err}" "${DIR}/small.exr: size 4x4 differs from ${DIR}/a.exr (8x6)")
+elseif(MODE STREQUAL "converge")
+  run_canopy(0 converge "${SCENE}" --reference "${DIR}/ref.exr" --reference-spp 64
+             --reference-sampler tree-split --samplers power,tree,tree-split:0.5 --budget 2
+             --seeds 2 --out "${DIR}/tiny")
+  foreach(f tiny.csv tiny-median.csv tiny-configs.csv tiny-time.png tiny-rays.png ref.exr)
+    if(NOT EXISTS "${DIR}/${f}")
+      message(FATAL_ERROR "canopy converge did not write ${DIR}/${f}\nstdout:\n${out}")
+    endif()
+  endforeach()
+  file(STRINGS "${DIR}/tiny.csv" rows)
+  list(GET rows 0 header)
+  expect_contains("${header}" "sampler,light_sampler,split_threshold,spp,seed,seconds,shadow_rays")
+  foreach(s ",power,power," ",tree,tree," ",tree-split:0.5,tree-split,0.5,")
+    expect_contains("${rows}" "${s}")
+  endforeach()
+  expect_contains("${out}" "equal-time RMSE")
+  expect_contains("${err}" "light_sampler tree-split") # the reference's metadata, read back
+  # A reference of the wrong size is invalid input.
+  run_canopy(2 converge "${SCENE}" --reference "${DIR}/ref.exr" --film-scale 0.5 --budget 1)
+  expect_contains("${err}" "${DIR}/ref.exr: size 32x24 differs from the render (16x12)")
+  run_canopy(2 converge "${SCENE}" --reference "${DIR}/ref.exr" --samplers power,bogus)
+  expect_contains("${err}" "--samplers: unknown light sampler 'bogus'")
+else()
+  message(FATAL_ERROR "cli_tools.cmake: unknown MODE '${MODE}'")
+endif()
