@@ -4,44 +4,56 @@
 // as both languages, so sampling on the host and on the device make the very same decisions.
 //
 // ---------------------------------------------------------------- device layout of the tree
-// The tree is 4-wide. Node `n` owns LT_NODE_F4 consecutive float4 in `nodes` (struct of arrays:
-// record k holds one quantity for the node's four children, lane i = child i) and one int4 in
-// `children`:
-//   nodes[n*11 + 0..2]  LT_CX, LT_CY, LT_CZ   bounding-sphere centre of each child
-//   nodes[n*11 + 3]     LT_R                  bounding-sphere radius (sphere of the child's bbox)
-//   nodes[n*11 + 4..6]  LT_AX, LT_AY, LT_AZ   orientation cone axis (unit)
-//   nodes[n*11 + 7]     LT_COS_O              cos(theta_o)  (normal bound)
-//   nodes[n*11 + 8]     LT_COS_E              cos(theta_e)  (emission bound, theta_e <= pi/2)
-//   nodes[n*11 + 9]     LT_ENERGY             sum of emitter energies (luminance of max intensity)
-//   nodes[n*11 + 10]    LT_CV2                squared coefficient of variation of the emitter
-//                                             energies, V[e]/E[e]^2 (dimensionless, for splitting)
-//   children[n].lane    >= 0: index of a child node
-//                       LT_EMPTY: unused lane (its energy is 0)
-//                       other < 0: leaf, code = -1 - child = (first << 2) | (count - 1): the
-//                       emitters leaf_lights[first .. first+count), count in 1..4
-// Node 0 is the root. Leaf emitters are not stored in the tree: their bounds are recomputed from
-// the `Light` records (lt_light_bounds) when a leaf is evaluated, so the tree costs ~40
-// bytes/emitter. trails[light]: the light's bit-trail, 2 bits per 4-wide level starting with the
-// root in the two lowest bits, then 2 bits for its index inside its leaf. root_sphere / root_info:
-// bounding sphere of all emitters; (cv2, total energy, 0, 0).
+// The tree is 4-wide. Node `n` owns LT_NODE_F4 (8) consecutive float4 in `nodes` (struct of
+// arrays: record k holds one quantity for the node's four children, lane i = child i; 128 bytes)
+// and one int4 in `children`:
+//   nodes[n*8 + 0..2]  LT_CX, LT_CY, LT_CZ   bounding-sphere centre of each child
+//   nodes[n*8 + 3]     LT_R                  bounding-sphere radius (sphere of the child's bbox)
+//   nodes[n*8 + 4]     LT_AXIS               orientation cone axis, octahedral, 2 x 16 bits (the
+//                                            bits of the float; lt_oct_decode_v)
+//   nodes[n*8 + 5]     LT_COS_O              cos(theta_o) (normal bound), widened by the axis
+//                                            quantisation error and rounded down
+//   nodes[n*8 + 6]     LT_ENERGY             sum of emitter energies (luminance of max intensity)
+//   nodes[n*8 + 7]     LT_CE_CV2             bits 0-15: cos(theta_e) * 65535 rounded down
+//                                            (emission bound, theta_e <= pi/2); bits 16-31: the
+//                                            high half of the float V[e]/E[e]^2 (squared
+//                                            coefficient of variation of the energies, splitting)
+//   children[n].lane   >= 0: index of a child node (the child nodes of a node are consecutive)
+//                      LT_EMPTY: unused lane (its energy is 0)
+//                      other < 0: leaf, code = -1 - child = (first << 2) | (count - 1): the
+//                      emitters leaf_lights[first .. first+count), count in 1..4
+// Node 0 is the root. After the num_nodes * 8 node records, `nodes` holds one emitter record of
+// LT_EMITTER_F4 (2) float4 per emitter in leaf order (index first + j), starting at float4 index
+// lt_emitter_base() (root_info.z holds its bits plus LT_EMITTER_BASE_BIAS):
+//   record[0]  bounding sphere of the emitter (centre, radius), as in the nodes
+//   record[1]  x: octahedral axis bits; y: cone q (q <= 1: cos(theta_o), theta_e = pi/2; q > 1.5:
+//              theta_o = 0, cos(theta_e) = q - 2; widened by the axis quantisation error);
+//              z: energy; w: bits of the light index (= leaf_lights[first + j])
+// so a leaf is ranked from its records without touching the scene's Light buffer. The tree costs
+// 52-61 bytes/emitter. trails[light]: the light's bit-trail, 2 bits per 4-wide level starting with
+// the root in the two lowest bits, then 2 bits for its index inside its leaf. root_sphere /
+// root_info: bounding sphere of all emitters; (cv2, total energy, emitter record base, 0).
 #ifndef CANOPY_LIGHT_TREE_MATH_H
 #define CANOPY_LIGHT_TREE_MATH_H
 
 #include "compat.h"
 #include "types.h"
 
-#define LT_NODE_F4 11
+#define LT_NODE_F4 8
 #define LT_CX 0
 #define LT_CY 1
 #define LT_CZ 2
 #define LT_R 3
-#define LT_AX 4
-#define LT_AY 5
-#define LT_AZ 6
-#define LT_COS_O 7
-#define LT_COS_E 8
-#define LT_ENERGY 9
-#define LT_CV2 10
+#define LT_AXIS 4
+#define LT_COS_O 5
+#define LT_ENERGY 6
+#define LT_CE_CV2 7
+
+// Emitter records: LT_EMITTER_F4 float4 per emitter, in leaf order, after the node records.
+#define LT_EMITTER_F4 2
+#define LT_EMITTER_BASE_BIAS 0x40000000u
+#define LT_OCT_SCALE 3.0518044e-05f /* 2 / 65535 */
+#define LT_U16_SCALE 1.5259022e-05f /* 1 / 65535 */
 
 #define LT_EMPTY (-2147483647 - 1)
 #define LT_MAX_LEAF 4
@@ -75,8 +87,21 @@ typedef int4 lt_mask4;
 #define lt_sel4(a, b, m) select(a, b, m) /* m ? b : a, lane-wise */
 #define lt_minf(a, b) fmin(a, b)
 #define lt_maxf(a, b) fmax(a, b)
-#define LT_HOT INLINE
+#define LT_HOT static inline __attribute__((always_inline))
+// CPU devices (PoCL) have one flat address space: prefetch through an integer round trip (clang's
+// builtin takes a private pointer in OpenCL C 1.2).
+#if defined(__clang__) && defined(__x86_64__)
+#define LT_PREFETCH(addr) __builtin_prefetch((const void*)(ulong)(addr))
+#else
 #define LT_PREFETCH(addr) ((void)(addr))
+#endif
+// The low / high 16 bits of the bit patterns of four floats, as floats (exact).
+INLINE float4 lt_lo16_4(float4 bits) {
+  return convert_float4(as_uint4(bits) & (uint4)(0xffffu));
+}
+INLINE float4 lt_hi16_4(float4 bits) {
+  return convert_float4(as_uint4(bits) >> (uint4)(16u));
+}
 #else
 // C++ (host reference): the same lane-wise operations on SSE registers (x86-64) or scalars.
 #if defined(__SSE2__)
@@ -120,6 +145,14 @@ INLINE lt_mask4 lt_and4(lt_mask4 a, lt_mask4 b) {
 INLINE float4 lt_sel4(float4 a, float4 b, lt_mask4 m) {
   return lt_f4_(_mm_or_ps(_mm_and_ps(m, lt_ps_(b)), _mm_andnot_ps(m, lt_ps_(a))));
 }
+INLINE float4 lt_lo16_4(float4 bits) {
+  __m128i i = _mm_and_si128(_mm_castps_si128(lt_ps_(bits)), _mm_set1_epi32(0xffff));
+  return lt_f4_(_mm_cvtepi32_ps(i));
+}
+INLINE float4 lt_hi16_4(float4 bits) {
+  __m128i i = _mm_srli_epi32(_mm_castps_si128(lt_ps_(bits)), 16);
+  return lt_f4_(_mm_cvtepi32_ps(i));
+}
 #else
 typedef int4 lt_mask4;
 INLINE float4 lt_splat4(float s) {
@@ -154,6 +187,15 @@ INLINE lt_mask4 lt_and4(lt_mask4 a, lt_mask4 b) {
 INLINE float4 lt_sel4(float4 a, float4 b, lt_mask4 m) {
   return make_float4(m.x ? b.x : a.x, m.y ? b.y : a.y, m.z ? b.z : a.z, m.w ? b.w : a.w);
 }
+INLINE float4 lt_lo16_4(float4 b) {
+  return make_float4((float)(float_as_uint_(b.x) & 0xffffu), (float)(float_as_uint_(b.y) & 0xffffu),
+                     (float)(float_as_uint_(b.z) & 0xffffu),
+                     (float)(float_as_uint_(b.w) & 0xffffu));
+}
+INLINE float4 lt_hi16_4(float4 b) {
+  return make_float4((float)(float_as_uint_(b.x) >> 16), (float)(float_as_uint_(b.y) >> 16),
+                     (float)(float_as_uint_(b.z) >> 16), (float)(float_as_uint_(b.w) >> 16));
+}
 #endif
 INLINE float lt_minf(float a, float b) {
   return b < a ? b : a;
@@ -169,6 +211,141 @@ INLINE float lt_maxf(float a, float b) {
 #define LT_PREFETCH(addr) ((void)(addr))
 #endif
 #endif // __OPENCL_C_VERSION__
+
+// ---------------------------------------------------------------- 4-lane vectors for the hot path
+// lt_v4 is float4 on the device, an SSE register on the x86-64 host (the float4 struct of
+// compat.h would go through memory). Every operation is the same IEEE operation lane by lane, in
+// the same order, so host and device compute identical bits.
+#ifdef __OPENCL_C_VERSION__
+typedef float4 lt_v4;
+typedef int4 lt_vm4;
+#define lt_vf(a) (a)
+#define lt_fv(a) (a)
+#define lt_vld(p) (*(p))
+#define lt_vs(s) ((float4)(s))
+#define lt_vadd(a, b) ((a) + (b))
+#define lt_vsub(a, b) ((a) - (b))
+#define lt_vmul(a, b) ((a) * (b))
+#define lt_vdiv(a, b) ((a) / (b))
+#define lt_vsqrt(a) sqrt(a)
+#define lt_vmin(a, b) fmin(a, b)
+#define lt_vmax(a, b) fmax(a, b)
+#define lt_vlt(a, b) ((a) < (b))
+#define lt_vle(a, b) ((a) <= (b))
+#define lt_vgt(a, b) ((a) > (b))
+#define lt_vge(a, b) ((a) >= (b))
+#define lt_vand(a, b) ((a) & (b))
+#define lt_vsel(a, b, m) select(a, b, m)
+#define lt_vlo16(a) convert_float4(as_uint4(a) & (uint4)(0xffffu))
+#define lt_vhi16(a) convert_float4(as_uint4(a) >> (uint4)(16u))
+#define lt_vtranspose(a, b, c, d)                                                                  \
+  do {                                                                                             \
+    float4 t0_ = (float4)(a.x, b.x, c.x, d.x), t1_ = (float4)(a.y, b.y, c.y, d.y);                 \
+    float4 t2_ = (float4)(a.z, b.z, c.z, d.z), t3_ = (float4)(a.w, b.w, c.w, d.w);                 \
+    a = t0_;                                                                                       \
+    b = t1_;                                                                                       \
+    c = t2_;                                                                                       \
+    d = t3_;                                                                                       \
+  } while (0)
+INLINE float lt_vhmax(float4 a) {
+  return fmax(fmax(a.x, a.y), fmax(a.z, a.w));
+}
+INLINE float lt_vhmin(float4 a) {
+  return fmin(fmin(a.x, a.y), fmin(a.z, a.w));
+}
+INLINE float lt_vsum(float4 a) {
+  return (a.x + a.y) + (a.z + a.w);
+}
+#elif defined(__SSE2__)
+typedef __m128 lt_v4;
+typedef __m128 lt_vm4;
+INLINE lt_v4 lt_vf(float4 a) {
+  return _mm_load_ps(&a.x);
+}
+INLINE float4 lt_fv(lt_v4 v) {
+  float4 r;
+  _mm_store_ps(&r.x, v);
+  return r;
+}
+INLINE lt_v4 lt_vld(const float4* p) {
+  return _mm_load_ps(&p->x);
+}
+#define lt_vs(s) _mm_set1_ps(s)
+#define lt_vadd(a, b) _mm_add_ps(a, b)
+#define lt_vsub(a, b) _mm_sub_ps(a, b)
+#define lt_vmul(a, b) _mm_mul_ps(a, b)
+#define lt_vdiv(a, b) _mm_div_ps(a, b)
+#define lt_vsqrt(a) _mm_sqrt_ps(a)
+#define lt_vmin(a, b) _mm_min_ps(a, b)
+#define lt_vmax(a, b) _mm_max_ps(a, b)
+#define lt_vlt(a, b) _mm_cmplt_ps(a, b)
+#define lt_vle(a, b) _mm_cmple_ps(a, b)
+#define lt_vgt(a, b) _mm_cmpgt_ps(a, b)
+#define lt_vge(a, b) _mm_cmpge_ps(a, b)
+#define lt_vand(a, b) _mm_and_ps(a, b)
+INLINE lt_v4 lt_vsel(lt_v4 a, lt_v4 b, lt_vm4 m) {
+  return _mm_or_ps(_mm_and_ps(m, b), _mm_andnot_ps(m, a));
+}
+INLINE lt_v4 lt_vlo16(lt_v4 a) {
+  return _mm_cvtepi32_ps(_mm_and_si128(_mm_castps_si128(a), _mm_set1_epi32(0xffff)));
+}
+INLINE lt_v4 lt_vhi16(lt_v4 a) {
+  return _mm_cvtepi32_ps(_mm_srli_epi32(_mm_castps_si128(a), 16));
+}
+#define lt_vtranspose(a, b, c, d) _MM_TRANSPOSE4_PS(a, b, c, d)
+INLINE float lt_vhmax(lt_v4 a) {
+  __m128 m = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm_cvtss_f32(_mm_max_ss(m, _mm_movehl_ps(m, m)));
+}
+INLINE float lt_vhmin(lt_v4 a) {
+  __m128 m = _mm_min_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm_cvtss_f32(_mm_min_ss(m, _mm_movehl_ps(m, m)));
+}
+INLINE float lt_vsum(lt_v4 a) { // (x + y) + (z + w)
+  __m128 t = _mm_add_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
+  return _mm_cvtss_f32(_mm_add_ss(t, _mm_movehl_ps(t, t)));
+}
+#else
+typedef float4 lt_v4;
+typedef lt_mask4 lt_vm4;
+#define lt_vf(a) (a)
+#define lt_fv(a) (a)
+#define lt_vld(p) (*(p))
+#define lt_vs(s) lt_splat4(s)
+#define lt_vadd(a, b) ((a) + (b))
+#define lt_vsub(a, b) ((a) - (b))
+#define lt_vmul(a, b) ((a) * (b))
+#define lt_vdiv(a, b) ((a) / (b))
+#define lt_vsqrt(a) lt_sqrt4(a)
+#define lt_vmin(a, b) lt_min4(a, b)
+#define lt_vmax(a, b) lt_max4(a, b)
+#define lt_vlt(a, b) lt_lt4(a, b)
+#define lt_vle(a, b) lt_le4(a, b)
+#define lt_vgt(a, b) lt_gt4(a, b)
+#define lt_vge(a, b) lt_ge4(a, b)
+#define lt_vand(a, b) lt_and4(a, b)
+#define lt_vsel(a, b, m) lt_sel4(a, b, m)
+#define lt_vlo16(a) lt_lo16_4(a)
+#define lt_vhi16(a) lt_hi16_4(a)
+#define lt_vtranspose(a, b, c, d)                                                                  \
+  do {                                                                                             \
+    float4 t0_ = make_float4(a.x, b.x, c.x, d.x), t1_ = make_float4(a.y, b.y, c.y, d.y);           \
+    float4 t2_ = make_float4(a.z, b.z, c.z, d.z), t3_ = make_float4(a.w, b.w, c.w, d.w);           \
+    a = t0_;                                                                                       \
+    b = t1_;                                                                                       \
+    c = t2_;                                                                                       \
+    d = t3_;                                                                                       \
+  } while (0)
+INLINE float lt_vhmax(float4 a) {
+  return lt_maxf(lt_maxf(a.x, a.y), lt_maxf(a.z, a.w));
+}
+INLINE float lt_vhmin(float4 a) {
+  return lt_minf(lt_minf(a.x, a.y), lt_minf(a.z, a.w));
+}
+INLINE float lt_vsum(float4 a) {
+  return (a.x + a.y) + (a.z + a.w);
+}
+#endif
 
 INLINE float3 lt_min3(float3 a, float3 b) {
   return make_float3(lt_minf(a.x, b.x), lt_minf(a.y, b.y), lt_minf(a.z, b.z));
@@ -432,62 +609,79 @@ INLINE float4 lt_sphere_of_box(float3 bmin, float3 bmax) {
 // ratios matter) and a lane that can contribute gets at least LT_IMPORTANCE_FLOOR: the result is
 // never 0 for a cluster that can contribute and never overflows. If no lane can contribute, lanes
 // with energy get E/d^2 (see below); only lanes without energy are ever 0 then.
-LT_HOT float4 lt_importance4(float4 cx, float4 cy, float4 cz, float4 r, float4 ax, float4 ay,
-                             float4 az, float4 cos_o, float4 cos_e, float4 energy, float3 P,
-                             float3 N) {
-  float4 zero = lt_splat4(0.0f);
-  float4 one = lt_splat4(1.0f);
-  float4 dx = cx - lt_splat4(P.x);
-  float4 dy = cy - lt_splat4(P.y);
-  float4 dz = cz - lt_splat4(P.z);
-  float4 d2 = dx * dx + dy * dy + dz * dz;
-  float4 r2 = r * r;
-  lt_mask4 inside = lt_le4(d2, r2);
-  float4 d2c = lt_max4(lt_max4(d2, r2 * 0.25f), lt_splat4(1e-36f));
-  float4 inv_d = one / lt_sqrt4(lt_max4(d2, lt_splat4(1e-36f)));
-  float4 ux = dx * inv_d;
-  float4 uy = dy * inv_d;
-  float4 uz = dz * inv_d;
+LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt_v4 ay, lt_v4 az,
+                             lt_v4 cos_o, lt_v4 cos_e, lt_v4 energy, float3 P, float3 N) {
+  lt_v4 zero = lt_vs(0.0f);
+  lt_v4 one = lt_vs(1.0f);
+  lt_v4 dx = lt_vsub(cx, lt_vs(P.x));
+  lt_v4 dy = lt_vsub(cy, lt_vs(P.y));
+  lt_v4 dz = lt_vsub(cz, lt_vs(P.z));
+  lt_v4 d2 = lt_vadd(lt_vadd(lt_vmul(dx, dx), lt_vmul(dy, dy)), lt_vmul(dz, dz));
+  lt_v4 r2 = lt_vmul(r, r);
+  lt_vm4 inside = lt_vle(d2, r2);
+  lt_v4 d2c = lt_vmax(lt_vmax(d2, lt_vmul(r2, lt_vs(0.25f))), lt_vs(1e-36f));
+  // Every cosine and sine below is a dot or cross product scaled by 1/d, so the square roots run
+  // side by side instead of one after the other (the latency of this function bounds a descent).
+  lt_v4 inv_d = lt_vdiv(one, lt_vsqrt(lt_vmax(d2, lt_vs(1e-36f))));
   // theta_u: half-angle of the cone from P around the bounding sphere
-  float4 sin_u = lt_min4(r * inv_d, one);
-  float4 cos_u = lt_sqrt4(lt_max4(one - sin_u * sin_u, zero));
-  sin_u = lt_sel4(sin_u, zero, inside);
-  cos_u = lt_sel4(cos_u, lt_splat4(-1.0f), inside);
+  lt_v4 sin_u = lt_vmin(lt_vmul(r, inv_d), one);
+  lt_v4 cos_u = lt_vmin(lt_vmul(lt_vsqrt(lt_vmax(lt_vsub(d2, r2), zero)), inv_d), one);
+  sin_u = lt_vsel(sin_u, zero, inside);
+  cos_u = lt_vsel(cos_u, lt_vs(-1.0f), inside);
   // theta: angle between the cone axis and the direction from the cluster towards P
-  float4 cos_t = zero - (ax * ux + ay * uy + az * uz);
-  float4 sin_t = lt_sqrt4(lt_max4(one - cos_t * cos_t, zero));
-  float4 sin_o = lt_sqrt4(lt_max4(one - cos_o * cos_o, zero));
+  lt_v4 cos_t = lt_vmul(
+      lt_vsub(zero, lt_vadd(lt_vadd(lt_vmul(ax, dx), lt_vmul(ay, dy)), lt_vmul(az, dz))), inv_d);
+  lt_v4 kx = lt_vsub(lt_vmul(ay, dz), lt_vmul(az, dy));
+  lt_v4 ky = lt_vsub(lt_vmul(az, dx), lt_vmul(ax, dz));
+  lt_v4 kz = lt_vsub(lt_vmul(ax, dy), lt_vmul(ay, dx));
+  lt_v4 sin_t = lt_vmin(
+      lt_vmul(lt_vsqrt(lt_vadd(lt_vadd(lt_vmul(kx, kx), lt_vmul(ky, ky)), lt_vmul(kz, kz))), inv_d),
+      one);
+  lt_v4 sin_o = lt_vsqrt(lt_vmax(lt_vsub(one, lt_vmul(cos_o, cos_o)), zero));
   // theta - theta_o, clamped at 0
-  lt_mask4 within_o = lt_ge4(cos_t, cos_o);
-  float4 c1 = lt_sel4(cos_t * cos_o + sin_t * sin_o, one, within_o);
-  float4 s1 = lt_sel4(sin_t * cos_o - cos_t * sin_o, zero, within_o);
+  lt_vm4 within_o = lt_vge(cos_t, cos_o);
+  lt_v4 c1 = lt_vsel(lt_vadd(lt_vmul(cos_t, cos_o), lt_vmul(sin_t, sin_o)), one, within_o);
+  lt_v4 s1 = lt_vsel(lt_vsub(lt_vmul(sin_t, cos_o), lt_vmul(cos_t, sin_o)), zero, within_o);
   // minus theta_u, clamped at 0
-  float4 c2 = lt_sel4(c1 * cos_u + s1 * sin_u, one, lt_ge4(c1, cos_u));
-  float4 orient = lt_sel4(zero, c2, lt_gt4(c2, cos_e));
+  lt_v4 c2 = lt_vsel(lt_vadd(lt_vmul(c1, cos_u), lt_vmul(s1, sin_u)), one, lt_vge(c1, cos_u));
+  lt_v4 orient = lt_vsel(zero, c2, lt_vgt(c2, cos_e));
   // incidence at P
-  float4 cos_i = one;
+  lt_v4 cos_i = one;
   if (N.x != 0.0f || N.y != 0.0f || N.z != 0.0f) {
-    float4 ci = ux * N.x + uy * N.y + uz * N.z;
-    float4 si = lt_sqrt4(lt_max4(one - ci * ci, zero));
-    cos_i = lt_sel4(ci * cos_u + si * sin_u, one, lt_ge4(ci, cos_u));
-    cos_i = lt_max4(cos_i, zero);
+    lt_v4 nx = lt_vs(N.x), ny = lt_vs(N.y), nz = lt_vs(N.z);
+    lt_v4 ci = lt_vmul(lt_vadd(lt_vadd(lt_vmul(dx, nx), lt_vmul(dy, ny)), lt_vmul(dz, nz)), inv_d);
+    lt_v4 jx = lt_vsub(lt_vmul(ny, dz), lt_vmul(nz, dy));
+    lt_v4 jy = lt_vsub(lt_vmul(nz, dx), lt_vmul(nx, dz));
+    lt_v4 jz = lt_vsub(lt_vmul(nx, dy), lt_vmul(ny, dx));
+    lt_v4 si = lt_vmin(
+        lt_vmul(lt_vsqrt(lt_vadd(lt_vadd(lt_vmul(jx, jx), lt_vmul(jy, jy)), lt_vmul(jz, jz))),
+                inv_d),
+        one);
+    cos_i = lt_vsel(lt_vadd(lt_vmul(ci, cos_u), lt_vmul(si, sin_u)), one, lt_vge(ci, cos_u));
+    cos_i = lt_vmax(cos_i, zero);
   }
-  lt_mask4 alive = lt_gt4(energy, zero);
-  float emax = lt_hmax4(energy);
-  float dmin2 = lt_hmin4(lt_sel4(lt_splat4(3.0e38f), d2c, alive));
+  lt_vm4 alive = lt_vgt(energy, zero);
+  float emax = lt_vhmax(energy);
+  float dmin2 = lt_vhmin(lt_vsel(lt_vs(3.0e38f), d2c, alive));
   float inv_emax = emax > 0.0f ? 1.0f / emax : 0.0f;
-  float4 e = energy * inv_emax;
-  float4 g = lt_splat4(dmin2) / d2c;
-  float4 oc = orient * cos_i;
-  float4 imp = e * g * oc;
-  lt_mask4 contributes = lt_and4(alive, lt_gt4(oc, zero));
-  float4 res = lt_sel4(zero, lt_max4(imp, lt_splat4(LT_IMPORTANCE_FLOOR)), contributes);
+  lt_v4 e = lt_vmul(energy, lt_vs(inv_emax));
+  lt_v4 g = lt_vdiv(lt_vs(dmin2), d2c);
+  lt_v4 oc = lt_vmul(orient, cos_i);
+  lt_v4 imp = lt_vmul(lt_vmul(e, g), oc);
+  lt_vm4 contributes = lt_vand(alive, lt_vgt(oc, zero));
+  lt_v4 res = lt_vsel(zero, lt_vmax(imp, lt_vs(LT_IMPORTANCE_FLOOR)), contributes);
   // No lane can contribute but some has energy (bounds of the parent were looser than those of
   // its children): rank by energy and distance alone, so a descent never dead-ends and the pmf
   // sums to 1 over the lights with energy. Such picks contribute 0, which keeps them unbiased.
-  if (!(lt_sum4(res) > 0.0f) && emax > 0.0f)
-    res = lt_sel4(zero, lt_max4(e * g, lt_splat4(LT_IMPORTANCE_FLOOR)), alive);
+  if (!(lt_vsum(res) > 0.0f) && emax > 0.0f)
+    res = lt_vsel(zero, lt_vmax(lt_vmul(e, g), lt_vs(LT_IMPORTANCE_FLOOR)), alive);
   return res;
+}
+LT_HOT float4 lt_importance4(float4 cx, float4 cy, float4 cz, float4 r, float4 ax, float4 ay,
+                             float4 az, float4 cos_o, float4 cos_e, float4 energy, float3 P,
+                             float3 N) {
+  return lt_fv(lt_importance_v(lt_vf(cx), lt_vf(cy), lt_vf(cz), lt_vf(r), lt_vf(ax), lt_vf(ay),
+                               lt_vf(az), lt_vf(cos_o), lt_vf(cos_e), lt_vf(energy), P, N));
 }
 
 // ---------------------------------------------------------------- tree traversal (Alg. 2)
@@ -515,41 +709,80 @@ INLINE int lt_leaf_code(int first, int count) {
   return -1 - ((first << 2) | (count - 1));
 }
 
-LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) {
-  GLOBAL const float4* n = t->nodes + node * LT_NODE_F4;
-  return lt_importance4(n[LT_CX], n[LT_CY], n[LT_CZ], n[LT_R], n[LT_AX], n[LT_AY], n[LT_AZ],
-                        n[LT_COS_O], n[LT_COS_E], n[LT_ENERGY], P, N);
+// Emitter records (see the top of the file): float4 index of the first one.
+INLINE uint lt_emitter_base(const LtTree* t) {
+  return float_as_uint_(t->root_info.z) - LT_EMITTER_BASE_BIAS;
+}
+INLINE GLOBAL const float4* lt_emitter_records(const LtTree* t, int first) {
+  return t->nodes + lt_emitter_base(t) + (uint)first * LT_EMITTER_F4;
+}
+// Octahedral unit vectors from their two 16-bit fixed-point coordinates u, v (as floats,
+// 0..65535; stored as the low and high halves of a float's bits), normalised.
+LT_HOT void lt_oct_decode_v(lt_v4 u, lt_v4 v, lt_v4* ax, lt_v4* ay, lt_v4* az) {
+  lt_v4 one = lt_vs(1.0f);
+  lt_v4 zero = lt_vs(0.0f);
+  lt_v4 x = lt_vsub(lt_vmul(u, lt_vs(LT_OCT_SCALE)), one);
+  lt_v4 y = lt_vsub(lt_vmul(v, lt_vs(LT_OCT_SCALE)), one);
+  lt_v4 abs_x = lt_vmax(x, lt_vsub(zero, x));
+  lt_v4 abs_y = lt_vmax(y, lt_vsub(zero, y));
+  lt_v4 z = lt_vsub(lt_vsub(one, abs_x), abs_y);
+  lt_vm4 fold = lt_vlt(z, zero);
+  lt_v4 tx = lt_vsel(lt_vsub(abs_y, one), lt_vsub(one, abs_y), lt_vge(x, zero));
+  lt_v4 ty = lt_vsel(lt_vsub(abs_x, one), lt_vsub(one, abs_x), lt_vge(y, zero));
+  x = lt_vsel(x, tx, fold);
+  y = lt_vsel(y, ty, fold);
+  lt_v4 inv = lt_vdiv(one, lt_vsqrt(lt_vadd(lt_vadd(lt_vmul(x, x), lt_vmul(y, y)), lt_vmul(z, z))));
+  *ax = lt_vmul(x, inv);
+  *ay = lt_vmul(y, inv);
+  *az = lt_vmul(z, inv);
+}
+// The same on float4 (the build encodes with it; tests decode with it).
+LT_HOT void lt_oct_decode4(float4 u, float4 v, float4* ax, float4* ay, float4* az) {
+  lt_v4 x, y, z;
+  lt_oct_decode_v(lt_vf(u), lt_vf(v), &x, &y, &z);
+  *ax = lt_fv(x);
+  *ay = lt_fv(y);
+  *az = lt_fv(z);
 }
 
-// Importance of the (up to four) emitters of a leaf, from their Light records.
+// Importance of the (up to four) emitters of a leaf, from their emitter records.
 LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) {
-  int first = lt_leaf_first(code);
   int count = lt_leaf_count(code);
-  float v[10][4];
-  for (int j = 0; j < 4; ++j) {
-    for (int k = 0; k < 10; ++k)
-      v[k][j] = 0.0f;
-    if (j < count) {
-      float3 bmin, bmax, axis;
-      float co, ce, en;
-      lt_light_bounds(t->lights + t->leaf_lights[first + j], &bmin, &bmax, &axis, &co, &ce, &en);
-      float4 s = lt_sphere_of_box(bmin, bmax);
-      v[0][j] = s.x;
-      v[1][j] = s.y;
-      v[2][j] = s.z;
-      v[3][j] = s.w;
-      v[4][j] = axis.x;
-      v[5][j] = axis.y;
-      v[6][j] = axis.z;
-      v[7][j] = co;
-      v[8][j] = ce;
-      v[9][j] = en;
-    }
+  GLOBAL const float4* e = lt_emitter_records(t, lt_leaf_first(code));
+  lt_v4 zero = lt_vs(0.0f);
+  lt_v4 a0 = lt_vld(e), b0 = lt_vld(e + 1);
+  lt_v4 a1 = zero, b1 = zero, a2 = zero, b2 = zero, a3 = zero, b3 = zero;
+  if (count > 1) {
+    a1 = lt_vld(e + 2);
+    b1 = lt_vld(e + 3);
   }
-#define LT_V4(k) make_float4(v[k][0], v[k][1], v[k][2], v[k][3])
-  return lt_importance4(LT_V4(0), LT_V4(1), LT_V4(2), LT_V4(3), LT_V4(4), LT_V4(5), LT_V4(6),
-                        LT_V4(7), LT_V4(8), LT_V4(9), P, N);
-#undef LT_V4
+  if (count > 2) {
+    a2 = lt_vld(e + 4);
+    b2 = lt_vld(e + 5);
+  }
+  if (count > 3) {
+    a3 = lt_vld(e + 6);
+    b3 = lt_vld(e + 7);
+  }
+  lt_vtranspose(a0, a1, a2, a3); // centre x, y, z, radius
+  lt_vtranspose(b0, b1, b2, b3); // axis bits, q, energy, light
+  lt_v4 ax, ay, az;
+  lt_oct_decode_v(lt_vlo16(b0), lt_vhi16(b0), &ax, &ay, &az);
+  lt_vm4 spot = lt_vgt(b1, lt_vs(1.5f));
+  lt_v4 cos_o = lt_vsel(b1, lt_vs(1.0f), spot);
+  lt_v4 cos_e = lt_vsel(zero, lt_vsub(b1, lt_vs(2.0f)), spot);
+  return lt_fv(lt_importance_v(a0, a1, a2, a3, ax, ay, az, cos_o, cos_e, b2, P, N));
+}
+
+LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) {
+  GLOBAL const float4* n = t->nodes + node * LT_NODE_F4;
+  lt_v4 axis = lt_vld(n + LT_AXIS);
+  lt_v4 ax, ay, az;
+  lt_oct_decode_v(lt_vlo16(axis), lt_vhi16(axis), &ax, &ay, &az);
+  lt_v4 cos_e = lt_vmul(lt_vlo16(lt_vld(n + LT_CE_CV2)), lt_vs(LT_U16_SCALE));
+  return lt_fv(lt_importance_v(lt_vld(n + LT_CX), lt_vld(n + LT_CY), lt_vld(n + LT_CZ),
+                               lt_vld(n + LT_R), ax, ay, az, lt_vld(n + LT_COS_O), cos_e,
+                               lt_vld(n + LT_ENERGY), P, N));
 }
 
 // Importances of the four lanes below `code` (a node or a leaf).
@@ -587,7 +820,8 @@ LT_HOT int lt_choose_lane(float4 imp, float* xi) {
   return k;
 }
 
-// Prefetches (host) the records of the children of `node` that the next step will read.
+// Prefetches the records of the children of a node that the next step may read: node records
+// and child codes of its child nodes, emitter records of its leaves.
 LT_HOT void lt_prefetch_children(const LtTree* t, int4 ch) {
   for (int k = 0; k < 4; ++k) {
     int c = i4_get(ch, k);
@@ -595,11 +829,12 @@ LT_HOT void lt_prefetch_children(const LtTree* t, int4 ch) {
       GLOBAL const float4* n = t->nodes + c * LT_NODE_F4;
       LT_PREFETCH(n);
       LT_PREFETCH(n + 4);
-      LT_PREFETCH(n + 8);
-      LT_PREFETCH(n + 10);
+      LT_PREFETCH(n + 7);
       LT_PREFETCH(t->children + c);
     } else if (c != LT_EMPTY) {
-      LT_PREFETCH(t->leaf_lights + lt_leaf_first(c));
+      GLOBAL const float4* e = lt_emitter_records(t, lt_leaf_first(c));
+      LT_PREFETCH(e);
+      LT_PREFETCH(e + LT_EMITTER_F4 * lt_leaf_count(c) - 1);
     }
   }
 }
@@ -631,12 +866,20 @@ INLINE int lt_pick_below(const LtTree* t, int code, float3 P, float3 N, float xi
     code = i4_get(ch, lane);
   }
   if (code == LT_EMPTY) return -1;
+  // The caller samples the chosen light next: start fetching the leaf's Light records now.
+  GLOBAL const float4* rec = lt_emitter_records(t, lt_leaf_first(code));
+  int count = lt_leaf_count(code);
+  for (int j = 0; j < count; ++j) {
+    GLOBAL const Light* L = t->lights + float_as_uint_(rec[j * LT_EMITTER_F4 + 1].w);
+    LT_PREFETCH(L);
+    LT_PREFETCH((GLOBAL const float4*)L + 5);
+  }
   float4 imp = lt_leaf_importance(t, code, P, N);
   int lane = lt_choose_lane(imp, &xi);
   if (lane < 0) return -1;
   p = p * lt_lane_prob(imp, lane);
   *prob = p;
-  return t->leaf_lights[lt_leaf_first(code) + lane];
+  return (int)float_as_uint_(rec[lane * LT_EMITTER_F4 + 1].w); // = leaf_lights[first + lane]
 }
 
 // Probability that lt_pick_below(code) returns the light whose remaining trail (decision at `code`
@@ -651,8 +894,7 @@ INLINE float lt_pmf_below(const LtTree* t, int code, float3 P, float3 N, uint tr
     if (next >= 0) {
       LT_PREFETCH(t->nodes + next * LT_NODE_F4);
       LT_PREFETCH(t->nodes + next * LT_NODE_F4 + 4);
-      LT_PREFETCH(t->nodes + next * LT_NODE_F4 + 8);
-      LT_PREFETCH(t->nodes + next * LT_NODE_F4 + 10);
+      LT_PREFETCH(t->nodes + next * LT_NODE_F4 + 7);
       LT_PREFETCH(t->children + next);
     }
     float4 imp = lt_node_importance(t, code, P, N);
@@ -693,7 +935,8 @@ INLINE float4 lt_lane_sphere(const LtTree* t, int node, int lane) {
                      f4_get(n[LT_R], lane));
 }
 INLINE float lt_lane_cv2(const LtTree* t, int node, int lane) {
-  return f4_get(t->nodes[node * LT_NODE_F4 + LT_CV2], lane);
+  return uint_as_float_(float_as_uint_(f4_get(t->nodes[node * LT_NODE_F4 + LT_CE_CV2], lane)) &
+                        0xffff0000u);
 }
 
 // pmf of `light` under splitting (DESIGN §4 "MIS with splitting"): 1 above the item where the

@@ -63,7 +63,7 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
   ASSERT_EQ(int(t.leaf_lights.size()), n);
   ASSERT_EQ(int(t.trails.size()), n);
   ASSERT_LE(t.levels, LT_MAX_NODE_LEVELS);
-  ASSERT_EQ(t.nodes.size(), size_t(t.num_nodes()) * LT_NODE_F4);
+  ASSERT_EQ(t.nodes.size(), size_t(t.num_nodes()) * LT_NODE_F4 + size_t(n) * LT_EMITTER_F4);
   // every light exactly once in the leaves
   std::vector<int> seen(n, 0);
   for (int l : t.leaf_lights) {
@@ -121,20 +121,49 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
                       1e-6 * (std::fabs(centre.x) + std::fabs(centre.y) + std::fabs(centre.z) + r))
             << "light " << l;
       }
-      // cone covers the light's cone
+      // cone covers the light's cone (axis decoded as the traversal decodes it)
       double co = lane(code, LT_COS_O, k);
       if (co > -1.0) {
-        float3 axis = make_float3(lane(code, LT_AX, k), lane(code, LT_AY, k), lane(code, LT_AZ, k));
+        float4 ax, ay, az;
+        float4 bits = t.nodes[size_t(code) * LT_NODE_F4 + LT_AXIS];
+        lt_oct_decode4(lt_lo16_4(bits), lt_hi16_4(bits), &ax, &ay, &az);
+        float3 axis = make_float3(f4_get(ax, k), f4_get(ay, k), f4_get(az, k));
         double need = angle_d(axis, b.cone.axis) + b.cone.theta_o;
         ASSERT_LE(need, std::acos(std::clamp(co, -1.0, 1.0)) + 1e-5) << "light " << l;
       }
-      ASSERT_LE(lane(code, LT_COS_E, k), std::cos(double(b.cone.theta_e)) + 1e-6);
+      double ce = f4_get(lt_lo16_4(t.nodes[size_t(code) * LT_NODE_F4 + LT_CE_CV2]), k) *
+                  double(LT_U16_SCALE);
+      ASSERT_LE(ce, std::cos(double(b.cone.theta_e)) + 1e-6);
       ASSERT_GE(lane(code, LT_ENERGY, k), b.energy * (1 - 1e-6));
       code = c;
     }
     int idx = int(trail & 3u);
     ASSERT_LT(idx, lt_leaf_count(code));
     ASSERT_EQ(t.leaf_lights[lt_leaf_first(code) + idx], l);
+    // the emitter record bounds the light as conservatively as the nodes do
+    LtTree view = t.view(lights.data());
+    const float4* rec = lt_emitter_records(&view, lt_leaf_first(code) + idx);
+    ASSERT_EQ(int(float_as_uint_(rec[1].w)), l);
+    float4 sp = lt_sphere_of_box(b.bmin, b.bmax);
+    ASSERT_EQ(rec[0].x, sp.x);
+    ASSERT_EQ(rec[0].w, sp.w);
+    ASSERT_EQ(rec[1].z, b.energy);
+    float q = rec[1].y;
+    double rco = q > 1.5f ? 1.0 : double(q), rce = q > 1.5f ? double(q) - 2.0 : 0.0;
+    ASSERT_LE(rce, std::cos(double(b.cone.theta_e)) + 1e-7) << "light " << l;
+    if (rco > -1.0) {
+      float4 ax, ay, az;
+      lt_oct_decode4(lt_lo16_4(rec[1]), lt_hi16_4(rec[1]), &ax, &ay, &az);
+      double err = angle_d(make_float3(ax.x, ay.x, az.x), b.cone.axis);
+      if (q > 1.5f) {
+        // theta_o = 0: the axis error widens theta_e
+        ASSERT_EQ(b.cone.theta_o, 0.0f);
+        ASSERT_LE(err + double(b.cone.theta_e), std::acos(std::clamp(rce, -1.0, 1.0)) + 1e-6);
+      } else {
+        ASSERT_LE(err + double(b.cone.theta_o), std::acos(std::clamp(rco, -1.0, 1.0)) + 1e-6)
+            << "light " << l;
+      }
+    }
   }
 }
 

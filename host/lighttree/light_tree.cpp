@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 namespace canopy {
@@ -18,6 +19,7 @@ constexpr float kHalfPi = 1.57079637f;                  // float(pi/2) == acosf(
 constexpr int kMaxBinaryDepth = 2 * LT_MAX_NODE_LEVELS; // leaves at binary depth <= 30
 constexpr int kMaxBins = 64;
 constexpr int kParallelBinning = 1 << 16;
+constexpr int kPackLeaves = 16; // clusters of <= kPackLeaves * leaf_size emitters are packed
 
 inline float3 vmin(float3 a, float3 b) {
   return {b.x < a.x ? b.x : a.x, b.y < a.y ? b.y : a.y, b.z < a.z ? b.z : a.z};
@@ -49,6 +51,64 @@ inline LtCone ltcone(const HCone& h) {
   return lt_make_cone(h.axis, h.to, h.te);
 }
 
+// Alg. 1 for a cone `a` not covering the narrower `b` when the union is less than the sphere,
+// without trigonometry but one atan2: every angle sum and the half angle theta_r are formed from
+// (cos, sin) pairs, all in double. The new axis is a rotated towards b by theta_r, theta_o =
+// theta_o(a) + theta_r, padded by LT_CONE_PAD and then checked to cover both inputs. Returns false
+// (the caller uses lt_cone_union) for nearly parallel axes or when the check fails.
+inline bool hunion_rotate(const HCone& a, const HCone& b, float te, HCone* out) {
+  const double ax = a.axis.x, ay = a.axis.y, az = a.axis.z;
+  const double bx = b.axis.x, by = b.axis.y, bz = b.axis.z;
+  const double cd = ax * bx + ay * by + az * bz;
+  const double kx = ay * bz - az * by, ky = az * bx - ax * bz, kz = ax * by - ay * bx;
+  const double sd = std::sqrt(kx * kx + ky * ky + kz * kz);
+  if (!(sd > 1e-4)) return false;
+  const double ca = a.co, sa = a.so, cb = b.co, sb = b.so;
+  const double c1 = cd * cb - sd * sb, s1 = sd * cb + cd * sb;     // theta_d + theta_o(b)
+  const double cphi = c1 * ca + s1 * sa, sphi = s1 * ca - c1 * sa; // ... - theta_o(a)
+  if (!(sphi >= 0.0)) return false;
+  double cr, sr; // theta_r = phi / 2 in [0, pi/2]
+  if (cphi >= 0.0) {
+    cr = std::sqrt((1.0 + cphi) * 0.5);
+    sr = sphi / (2.0 * cr);
+  } else {
+    sr = std::sqrt((1.0 - cphi) * 0.5);
+    cr = sphi / (2.0 * sr);
+  }
+  // unit vector perpendicular to a.axis, towards b.axis
+  const double wx = (bx - ax * cd) / sd, wy = (by - ay * cd) / sd, wz = (bz - az * cd) / sd;
+  double nx = ax * cr + wx * sr, ny = ay * cr + wy * sr, nz = az * cr + wz * sr;
+  const double nl = std::sqrt(nx * nx + ny * ny + nz * nz);
+  const float3 axis = make_float3(float(nx / nl), float(ny / nl), float(nz / nl));
+  const double co = ca * cr - sa * sr, so = sa * cr + ca * sr; // theta_o(a) + theta_r
+  if (!(so > 0.0)) return false;
+  const double pad = LT_CONE_PAD;
+  const double to = std::atan2(so, co) + pad;
+  if (!(to < M_PI)) return false;
+  const double cop = co - so * pad, sop = so + co * pad; // cos, sin of `to` (to O(pad^2))
+  for (const HCone* x : {&a, &b}) {
+    // covered iff alpha = angle(axis, x.axis) <= delta = to - theta_o(x): sin(delta - alpha) > 0
+    const double dx = x->axis.x, dy = x->axis.y, dz = x->axis.z;
+    const double d = axis.x * dx + axis.y * dy + axis.z * dz;
+    const double ex = axis.y * dz - axis.z * dy, ey = axis.z * dx - axis.x * dz,
+                 ez = axis.x * dy - axis.y * dx;
+    const double e = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double cdel = cop * x->co + sop * x->so, sdel = sop * x->co - cop * x->so;
+    if (!(sdel * d - cdel * e > 0.0)) return false;
+  }
+  HCone r;
+  r.axis = axis;
+  float tf = static_cast<float>(to);
+  if (double(tf) < to) tf = std::nextafter(tf, FLT_INF);
+  r.to = tf;
+  r.te = te;
+  r.co = static_cast<float>(cop);
+  r.so = static_cast<float>(sop);
+  r.empty = false;
+  *out = r;
+  return true;
+}
+
 // Alg. 1 with fast paths for the common cases (one cone already covers the other).
 inline HCone hunion(const HCone& x, const HCone& y) {
   if (y.empty) return x;
@@ -62,6 +122,17 @@ inline HCone hunion(const HCone& x, const HCone& y) {
     return r;
   }
   float cd = dot(a.axis, b.axis);
+  // The union's theta_o, (to_a + theta_d + to_b) / 2, reaches pi iff theta_d >= 2pi - to_a - to_b,
+  // i.e. (when to_a + to_b >= pi) iff cos(theta_d) <= cos(to_a + to_b): the whole sphere (what
+  // Alg. 1 returns then), without trigonometry. Rounding here only ever widens the cone.
+  if (a.to + b.to >= kPi && cd <= a.co * b.co - a.so * b.so) {
+    HCone r = a;
+    r.to = kPi;
+    r.co = -1.0f;
+    r.so = 0.0f;
+    r.te = te;
+    return r;
+  }
   // covered iff theta_d <= to_a - to_b, i.e. cos(theta_d) >= cos(to_a - to_b); the margin keeps
   // rounding of the cosines on the safe side.
   if ((a.axis.x == b.axis.x && a.axis.y == b.axis.y && a.axis.z == b.axis.z) ||
@@ -70,6 +141,8 @@ inline HCone hunion(const HCone& x, const HCone& y) {
     r.te = te;
     return r;
   }
+  HCone r;
+  if (hunion_rotate(a, b, te, &r)) return r;
   return hcone(lt_cone_union(ltcone(a), ltcone(b)));
 }
 
@@ -170,8 +243,7 @@ struct BinMap {
 
 class Builder {
 public:
-  Builder(std::vector<Prim>& prims, std::vector<BinaryLightNode>& nodes,
-          const LightTreeBuildOptions& opt)
+  Builder(std::vector<Prim>& prims, BinaryLightNode* nodes, const LightTreeBuildOptions& opt)
       : prims_(prims), nodes_(nodes), opt_(opt) {}
 
   std::atomic<int> next{1};
@@ -194,6 +266,24 @@ public:
     }
     if (n <= 1 || n <= opt_.leaf_size || depth >= kMaxBinaryDepth) {
       if (n > LT_MAX_LEAF) throw std::logic_error("light tree: leaf too large");
+      return;
+    }
+    // Small clusters (at most kPackLeaves leaves' worth, 64 emitters) are packed into as few full
+    // leaves as possible: median splits along the widest centroid axis into multiples of
+    // leaf_size (halving the number of leaves). Fuller leaves and fuller 4-wide nodes keep the
+    // tree with its emitter records under 64 bytes/emitter, and skip the SAOH binning where it
+    // matters least (the emitters of a leaf are ranked individually by their records anyway).
+    if (n <= kPackLeaves * opt_.leaf_size) {
+      int leaves = (n + opt_.leaf_size - 1) / opt_.leaf_size;
+      int m = begin + opt_.leaf_size * ((leaves + 1) / 2);
+      float3 ce = acc.cmax - acc.cmin;
+      if (ce.x > 0 || ce.y > 0 || ce.z > 0) {
+        int a = ce.x >= ce.y && ce.x >= ce.z ? 0 : (ce.y >= ce.z ? 1 : 2);
+        std::nth_element(prims_.data() + begin, prims_.data() + m, prims_.data() + end,
+                         [a](const Prim& p, const Prim& q) { return comp(p.c, a) < comp(q.c, a); });
+      }
+      recurse(ni, begin, m, end, depth, reduce_range(prims_.data(), begin, m),
+              reduce_range(prims_.data(), m, end));
       return;
     }
     // Child capacity at depth + 1 so every leaf ends at binary depth <= kMaxBinaryDepth.
@@ -327,16 +417,9 @@ private:
   }
 
   std::vector<Prim>& prims_;
-  std::vector<BinaryLightNode>& nodes_;
+  BinaryLightNode* nodes_; // room for 2n - 1 nodes, written in place (see the caller)
   const LightTreeBuildOptions& opt_;
 };
-
-inline float cos_of_theta_o(float to) {
-  return to >= kPi ? -1.0f : (to <= 0.0f ? 1.0f : std::cos(to));
-}
-inline float cos_of_theta_e(float te) {
-  return te >= kHalfPi ? 0.0f : (te <= 0.0f ? 1.0f : std::cos(te));
-}
 
 } // namespace
 
@@ -351,6 +434,8 @@ EmitterBounds emitter_bounds(const Light& light) {
   float3 axis;
   float co, ce, e;
   lt_light_bounds(&light, &b.bmin, &b.bmax, &axis, &co, &ce, &e);
+  b.cos_o = co;
+  b.cos_e = ce;
   float to = co >= 1.0f ? 0.0f : (co <= -1.0f ? kPi : std::acos(co));
   float te = ce <= 0.0f ? kHalfPi : std::acos(ce);
   b.cone = lt_make_cone(axis, to, te);
@@ -403,11 +488,18 @@ BinaryLightTree build_binary_light_tree(const std::vector<EmitterBounds>& emitte
       p.id = i;
     }
   });
-  bt.nodes.resize(2 * static_cast<size_t>(n));
-  Builder b(prims, bt.nodes, opt);
+  // Room for the 2n - 1 nodes of the worst case, allocated without being touched (a build uses
+  // far fewer: value-initialising 2n nodes up front cost more page faults than the whole SAOH
+  // build of the used ones). BinaryLightNode is an implicit-lifetime type: the builder assigns
+  // every field of the nodes it creates.
+  std::unique_ptr<BinaryLightNode, void (*)(BinaryLightNode*)> room(
+      static_cast<BinaryLightNode*>(
+          ::operator new(2 * static_cast<size_t>(n) * sizeof(BinaryLightNode))),
+      [](BinaryLightNode* p) { ::operator delete(p); });
+  Builder b(prims, room.get(), opt);
   Acc root = reduce_range(prims.data(), 0, n);
   b.build(0, 0, n, 0, root);
-  bt.nodes.resize(b.next.load());
+  bt.nodes.assign(room.get(), room.get() + b.next.load());
   bt.depth = b.max_depth.load();
   bt.order.resize(n);
   for (int i = 0; i < n; ++i)
@@ -437,48 +529,122 @@ inline void set_lane_value(float4& v, int lane, float x) {
   (lane == 0 ? v.x : lane == 1 ? v.y : lane == 2 ? v.z : v.w) = x;
 }
 
+// Octahedral encoding of a unit axis in 2 x 16 bits (decoded by lt_oct_decode4, nearest grid
+// point); returns the bits and an upper bound of the angle between the decoded and the exact axis.
+uint32_t oct_encode(float3 a, double* err) {
+  float s = std::fabs(a.x) + std::fabs(a.y) + std::fabs(a.z);
+  float px = s > 0 ? a.x / s : 0.0f, py = s > 0 ? a.y / s : 0.0f;
+  if (a.z < 0) {
+    float fx = (1.0f - std::fabs(py)) * (px >= 0 ? 1.0f : -1.0f);
+    float fy = (1.0f - std::fabs(px)) * (py >= 0 ? 1.0f : -1.0f);
+    px = fx;
+    py = fy;
+  }
+  double cu = std::clamp(std::nearbyint((double(px) + 1.0) * 0.5 * 65535.0), 0.0, 65535.0);
+  double cv = std::clamp(std::nearbyint((double(py) + 1.0) * 0.5 * 65535.0), 0.0, 65535.0);
+  float4 ax, ay, az;
+  lt_oct_decode4(lt_splat4(float(cu)), lt_splat4(float(cv)), &ax, &ay, &az);
+  // angle from the chord between the two (unit up to rounding) vectors, plus that rounding
+  double dx = double(ax.x) - a.x, dy = double(ay.x) - a.y, dz = double(az.x) - a.z;
+  double chord = std::sqrt(dx * dx + dy * dy + dz * dz);
+  *err = 2.0 * std::asin(std::min(1.0, 0.5 * chord)) + 4e-7;
+  return uint32_t(cu) | (uint32_t(cv) << 16);
+}
+
+// Largest float <= x.
+inline float float_down(double x) {
+  float f = static_cast<float>(x);
+  return double(f) > x ? std::nextafter(f, -FLT_INF) : f;
+}
+
+// The emitter record of one emitter (LT_EMITTER_F4 float4, see cl/light_tree_math.h): sphere;
+// (octahedral axis bits, q, energy, light index). q packs the cone: q <= 1: cos(theta_o) with
+// theta_e = pi/2; q > 1.5: theta_o = 0 and cos(theta_e) = q - 2 (exact). The cone is widened by
+// the axis quantisation error (theta_o when theta_e = pi/2, else theta_e), so the record's
+// importance is 0 only where the exact emitter's is.
+void emitter_record(const EmitterBounds& b, int light, float4* rec) {
+  rec[0] = lt_sphere_of_box(b.bmin, b.bmax);
+  double err = 0;
+  uint32_t oct = oct_encode(b.cone.axis, &err);
+  double pad = err * 1.001 + 1e-7;
+  double to = b.cos_o >= 1.0f ? 0.0 : (b.cos_o <= -1.0f ? M_PI : std::acos(double(b.cos_o)));
+  double te = b.cos_e <= 0.0f ? M_PI / 2 : std::acos(double(b.cos_e));
+  float q;
+  if (b.cos_o <= -1.0f) {
+    q = -1.0f; // omnidirectional: the axis does not matter
+  } else if (b.cos_e <= 0.0f || to > 0.0) {
+    // theta_e = pi/2 (or a general cone, widened to theta_o + theta_e, theta_e = pi/2)
+    double t = b.cos_e <= 0.0f ? to + pad : to + te + pad;
+    q = t >= M_PI ? -1.0f : std::max(float_down(std::cos(t)), -1.0f);
+  } else {
+    double t = te + pad; // theta_o = 0
+    q = t >= M_PI / 2 ? 1.0f : float_down(2.0 + std::max(std::cos(t), 0.0));
+  }
+  rec[1] = make_float4(uint_as_float_(oct), q, b.energy, uint_as_float_(uint32_t(light)));
+}
+
 // Greedy collapse fills every node with four lanes when it can (fewer levels); pairwise collapse
 // (each level = two binary levels) is the fallback that always fits the bit-trail budget, since the
-// builder keeps leaves at binary depth <= 2 * LT_MAX_NODE_LEVELS.
+// builder keeps leaves at binary depth <= 2 * LT_MAX_NODE_LEVELS. Every binary subtree of at most
+// LT_MAX_LEAF emitters becomes one leaf (its emitters are ranked individually by their records).
+// The children of a node get consecutive indices (one sibling block, visited depth-first), so the
+// prefetch of a node's children touches one contiguous range.
 struct TooDeep {};
 struct Collapser {
   const BinaryLightTree& bt;
   LightTree& t;
   bool greedy;
 
+  bool leafish(int bi) const {
+    const BinaryLightNode& n = bt.nodes[bi];
+    return n.is_leaf() || n.count <= LT_MAX_LEAF;
+  }
+
   void set_lane(int node, int lane, const BinaryLightNode& s) {
     float4* f = t.nodes.data() + size_t(node) * LT_NODE_F4;
     float4 sp = lt_sphere_of_box(s.bmin, s.bmax);
-    float v[LT_NODE_F4] = {sp.x,
-                           sp.y,
-                           sp.z,
-                           sp.w,
-                           s.cone.axis.x,
-                           s.cone.axis.y,
-                           s.cone.axis.z,
-                           cos_of_theta_o(s.cone.theta_o),
-                           cos_of_theta_e(s.cone.theta_e),
-                           static_cast<float>(s.energy),
-                           s.cv2()};
-    for (int k = 0; k < LT_NODE_F4; ++k)
-      set_lane_value(f[k], lane, v[k]);
+    float v[LT_NODE_F4];
+    v[LT_CX] = sp.x;
+    v[LT_CY] = sp.y;
+    v[LT_CZ] = sp.z;
+    v[LT_R] = sp.w;
+    double err = 0;
+    v[LT_AXIS] = uint_as_float_(oct_encode(s.cone.axis, &err));
+    // theta_o widened by the axis quantisation error, cosine rounded down
+    double to = double(s.cone.theta_o) + err * 1.001 + 1e-7;
+    v[LT_COS_O] =
+        s.cone.theta_o >= kPi || to >= M_PI ? -1.0f : std::max(float_down(std::cos(to)), -1.0f);
+    v[LT_ENERGY] = static_cast<float>(s.energy);
+    // cos(theta_e) in 16 bits, rounded down; the energy CV^2 as the high half of a float
+    double ce = s.cone.theta_e >= kHalfPi ? 0.0 : std::cos(double(s.cone.theta_e));
+    uint32_t k = uint32_t(std::clamp(std::floor(ce * 65535.0), 0.0, 65535.0));
+    while (k > 0 && double(float(k) * LT_U16_SCALE) > ce)
+      --k;
+    uint32_t cv2_bits = float_as_uint_(s.cv2()) & 0xffff0000u;
+    v[LT_CE_CV2] = uint_as_float_(cv2_bits | k);
+    for (int kk = 0; kk < LT_NODE_F4; ++kk)
+      set_lane_value(f[kk], lane, v[kk]);
   }
 
-  int make(int bi, int level, uint32_t prefix) {
-    if (level >= LT_MAX_NODE_LEVELS) {
-      if (greedy) throw TooDeep{};
-      throw std::logic_error("light tree: too deep for bit-trails");
-    }
+  int alloc_node() {
     int node = t.num_nodes();
     t.children.push_back(make_int4(LT_EMPTY, LT_EMPTY, LT_EMPTY, LT_EMPTY));
     for (int k = 0; k < LT_NODE_F4; ++k)
       t.nodes.push_back(make_float4(0, 0, 0, 0));
     t.nodes[size_t(node) * LT_NODE_F4 + LT_COS_O] = make_float4(1, 1, 1, 1);
+    return node;
+  }
+
+  void fill(int node, int bi, int level, uint32_t prefix) {
+    if (level >= LT_MAX_NODE_LEVELS) {
+      if (greedy) throw TooDeep{};
+      throw std::logic_error("light tree: too deep for bit-trails");
+    }
     t.levels = std::max(t.levels, level + 1);
     int slots[4];
     int ns = 0;
     const BinaryLightNode& x = bt.nodes[bi];
-    if (x.is_leaf()) {
+    if (leafish(bi)) {
       slots[ns++] = bi; // the root is a leaf
     } else if (greedy) {
       // Fill the four lanes by repeatedly opening the internal slot with the most emitters.
@@ -487,7 +653,7 @@ struct Collapser {
       while (ns < 4) {
         int best = -1;
         for (int k = 0; k < ns; ++k)
-          if (!bt.nodes[slots[k]].is_leaf() &&
+          if (!leafish(slots[k]) &&
               (best < 0 || bt.nodes[slots[k]].count > bt.nodes[slots[best]].count))
             best = k;
         if (best < 0) break;
@@ -501,7 +667,7 @@ struct Collapser {
     } else {
       for (int c : {x.left, x.right}) {
         const BinaryLightNode& cn = bt.nodes[c];
-        if (cn.is_leaf()) {
+        if (leafish(c)) {
           slots[ns++] = c;
         } else {
           slots[ns++] = cn.left;
@@ -509,28 +675,31 @@ struct Collapser {
         }
       }
     }
+    int codes[4];
+    for (int lane = 0; lane < ns; ++lane)
+      codes[lane] = leafish(slots[lane]) ? 0 : alloc_node(); // one contiguous sibling block
     for (int lane = 0; lane < ns; ++lane) {
       const BinaryLightNode& s = bt.nodes[slots[lane]];
       set_lane(node, lane, s);
       uint32_t trail = prefix | (uint32_t(lane) << (2 * level));
-      int code;
-      if (s.is_leaf()) {
-        code = lt_leaf_code(s.first, s.count);
+      if (leafish(slots[lane])) {
+        codes[lane] = lt_leaf_code(s.first, s.count);
         for (int j = 0; j < s.count; ++j)
           t.trails[bt.order[s.first + j]] = trail | (uint32_t(j) << (2 * (level + 1)));
-      } else {
-        code = make(slots[lane], level + 1, trail);
       }
       int4& ch = t.children[node];
-      (lane == 0 ? ch.x : lane == 1 ? ch.y : lane == 2 ? ch.z : ch.w) = code;
+      (lane == 0 ? ch.x : lane == 1 ? ch.y : lane == 2 ? ch.z : ch.w) = codes[lane];
     }
-    return node;
+    for (int lane = 0; lane < ns; ++lane)
+      if (!leafish(slots[lane]))
+        fill(codes[lane], slots[lane], level + 1, prefix | (uint32_t(lane) << (2 * level)));
   }
 };
 } // namespace
 
-LightTree collapse_light_tree(const BinaryLightTree& bt, int num_lights) {
+LightTree collapse_light_tree(const BinaryLightTree& bt, const std::vector<EmitterBounds>& eb) {
   LightTree t;
+  const int num_lights = static_cast<int>(eb.size());
   t.num_lights = num_lights;
   if (bt.nodes.empty()) return t;
   for (bool greedy : {true, false}) {
@@ -539,25 +708,36 @@ LightTree collapse_light_tree(const BinaryLightTree& bt, int num_lights) {
     t.nodes.clear();
     t.children.clear();
     t.levels = 0;
-    t.nodes.reserve(bt.nodes.size() / 2 * LT_NODE_F4 + LT_NODE_F4);
-    t.children.reserve(bt.nodes.size() / 2 + 1);
+    t.nodes.reserve(bt.nodes.size() / 6 * LT_NODE_F4 + LT_NODE_F4 +
+                    size_t(num_lights) * LT_EMITTER_F4);
+    t.children.reserve(bt.nodes.size() / 6 + 1);
     Collapser c{bt, t, greedy};
     try {
-      c.make(0, 0, 0u);
+      c.fill(c.alloc_node(), 0, 0, 0u);
       break;
     } catch (const TooDeep&) {
     }
   }
+  // Emitter records in leaf order after the node records.
+  const size_t base = t.nodes.size();
+  t.nodes.resize(base + size_t(num_lights) * LT_EMITTER_F4);
+  float4* rec = t.nodes.data() + base;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, num_lights, 4096), [&](const tbb::blocked_range<int>& r) {
+        for (int i = r.begin(); i != r.end(); ++i)
+          emitter_record(eb[bt.order[i]], bt.order[i], rec + size_t(i) * LT_EMITTER_F4);
+      });
   const BinaryLightNode& root = bt.nodes[0];
   t.root_sphere = lt_sphere_of_box(root.bmin, root.bmax);
-  t.root_info = make_float4(root.cv2(), static_cast<float>(root.energy), 0, 0);
+  t.root_info = make_float4(root.cv2(), static_cast<float>(root.energy),
+                            uint_as_float_(uint32_t(base) + LT_EMITTER_BASE_BIAS), 0);
   return t;
 }
 
 LightTree build_light_tree(const std::vector<Light>& lights, const LightTreeBuildOptions& opt) {
   std::vector<EmitterBounds> eb = emitter_bounds(lights);
   BinaryLightTree bt = build_binary_light_tree(eb, opt);
-  return collapse_light_tree(bt, static_cast<int>(lights.size()));
+  return collapse_light_tree(bt, eb);
 }
 
 } // namespace canopy

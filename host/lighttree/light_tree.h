@@ -3,14 +3,17 @@
 // kernels traverse with the functions of cl/light_tree_math.h.
 //
 // Device layout (upload each vector as one buffer, as is; see the top of cl/light_tree_math.h):
-//   nodes        float4 x LT_NODE_F4 (11) per 4-wide node: per-lane sphere centre x/y/z, radius,
-//                cone axis x/y/z, cos(theta_o), cos(theta_e), energy, energy CV^2
+//   nodes        float4 x LT_NODE_F4 (8) per 4-wide node: per-lane sphere centre x/y/z, radius,
+//                octahedral cone axis, cos(theta_o), energy, cos(theta_e) | energy CV^2 (16 bits
+//                each); then LT_EMITTER_F4 (2) float4 per emitter in leaf order (emitter records:
+//                sphere; axis, cone, energy, light index)
 //   children     int4 per node: child node index, LT_EMPTY, or a leaf code (lt_leaf_code)
 //   leaf_lights  int per emitter, light indices in leaf order (leaves are contiguous ranges)
 //   trails       uint per light index: bit-trail, 2 bits per level from the root, then 2 bits for
 //                the index inside the leaf
-//   root_sphere, root_info: two float4 kernel arguments (LtTree fields)
-// Leaf emitters are evaluated from the scene's Light buffer, which the kernels have anyway.
+//   root_sphere, root_info: two float4 kernel arguments (LtTree fields; root_info.z locates the
+//                emitter records)
+// The traversal reads only nodes and children (and the Light record of the light it returns).
 #pragma once
 
 #include "light_tree_math.h" // cl/: LtCone, LtTree, layout constants
@@ -22,11 +25,13 @@
 namespace canopy {
 
 // Bounds of one emitter (paper Table 1 and §5.1): box, cone, energy (luminance of the maximum
-// radiant intensity). Computed with lt_light_bounds() so the build and the leaf evaluation agree.
+// radiant intensity). Computed with lt_light_bounds(); the emitter records of the leaves are
+// built from them.
 struct EmitterBounds {
   float3 bmin, bmax;
   LtCone cone; // axis, theta_o, theta_e
   float energy;
+  float cos_o, cos_e; // the cone as lt_light_bounds gives it (cosines, exact)
 };
 EmitterBounds emitter_bounds(const Light& light);
 std::vector<EmitterBounds> emitter_bounds(const std::vector<Light>& lights); // parallel
@@ -84,7 +89,8 @@ struct LightTree {
   LtTree view(const Light* lights) const;
 };
 
-LightTree collapse_light_tree(const BinaryLightTree& bt, int num_lights);
+LightTree collapse_light_tree(const BinaryLightTree& bt,
+                              const std::vector<EmitterBounds>& emitters);
 // emitter_bounds + build_binary_light_tree + collapse_light_tree. An empty light list gives an
 // empty tree (num_nodes() == 0).
 LightTree build_light_tree(const std::vector<Light>& lights, const LightTreeBuildOptions& opt = {});
