@@ -37,6 +37,7 @@
 #define CANOPY_LIGHT_TREE_MATH_H
 
 #include "compat.h"
+#include "rng.h"
 #include "types.h"
 
 #define LT_NODE_F4 8
@@ -379,23 +380,15 @@ typedef struct LtRng {
   uint ctr;
 } LtRng;
 
-// "lowbias32" integer finaliser (C. Wellons): a bijection with good avalanche.
-INLINE uint lt_hash_u32(uint x) {
-  x ^= x >> 16;
-  x *= 0x7feb352du;
-  x ^= x >> 15;
-  x *= 0x846ca68bu;
-  x ^= x >> 16;
-  return x;
-}
+// Counter-based stream keyed by hash_u32 (cl/rng.h: the "lowbias32" finaliser).
 INLINE LtRng lt_rng_make(uint seed, uint stream) {
   LtRng r;
-  r.key = lt_hash_u32(lt_hash_u32(seed ^ 0x3c6ef372u) ^ (stream * 0x9e3779b9u + 0x7f4a7c15u));
+  r.key = hash_u32(hash_u32(seed ^ 0x3c6ef372u) ^ (stream * 0x9e3779b9u + 0x7f4a7c15u));
   r.ctr = 0u;
   return r;
 }
 INLINE uint lt_rng_next_u32(LtRng* r) {
-  uint x = lt_hash_u32(lt_hash_u32(r->ctr * 0x9e3779b9u + r->key) ^ r->key);
+  uint x = hash_u32(hash_u32(r->ctr * 0x9e3779b9u + r->key) ^ r->key);
   r->ctr += 1u;
   return x;
 }
