@@ -44,7 +44,8 @@ void Intersect_OpenCL(benchmark::State& state) {
                       const_cast<T*>(v.data()));
   };
   std::vector<int> queue(f.rays.o.size());
-  for (size_t i = 0; i < queue.size(); ++i) queue[i] = int(i);
+  for (size_t i = 0; i < queue.size(); ++i)
+    queue[i] = int(i);
   std::vector<Hit> hits(queue.size());
   cl::Buffer b_nodes = buf(f.bvh.nodes), b_idx = buf(f.bvh.prim_index), b_prims = buf(f.prims),
              b_queue = buf(queue), b_o = buf(f.rays.o), b_d = buf(f.rays.d), b_hits = buf(hits);
@@ -108,7 +109,8 @@ void Intersect_Embree8(benchmark::State& state) {
         rtcInitIntersectContext(&ctx);
         rtcIntersect8(valid, scene, &ctx, &rh);
         for (int j = 0; j < 8; ++j)
-          prim[8 * p + size_t(j)] = rh.hit.geomID[j] == RTC_INVALID_GEOMETRY_ID ? -1 : int(rh.hit.primID[j]);
+          prim[8 * p + size_t(j)] =
+              rh.hit.geomID[j] == RTC_INVALID_GEOMETRY_ID ? -1 : int(rh.hit.primID[j]);
       }
     });
     benchmark::DoNotOptimize(prim.data());

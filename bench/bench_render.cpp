@@ -42,11 +42,13 @@ void render_benchmark(benchmark::State& state, const std::string& scene_name,
   rs.spp = 4;
   r.render(rs); // warm-up: first launches, page faults
   RenderStats before = r.stats();
-  for (auto _ : state) r.render(rs);
+  for (auto _ : state)
+    r.render(rs);
   const RenderStats& after = r.stats();
   double seconds = after.render_seconds - before.render_seconds;
   state.counters["ms_per_spp"] = 1e3 * seconds / double(state.iterations() * rs.spp);
-  for (const char* stage : {"light_pick", "intersect_closest", "intersect_shadow", "shade_surface"}) {
+  for (const char* stage :
+       {"light_pick", "intersect_closest", "intersect_shadow", "shade_surface"}) {
     auto a = after.stages.find(stage);
     auto b = before.stages.find(stage);
     if (a == after.stages.end()) continue;
@@ -59,15 +61,30 @@ void render_benchmark(benchmark::State& state, const std::string& scene_name,
 
 } // namespace
 
-BENCHMARK_CAPTURE(render_benchmark, Render/default/tree_split, "default", "tree-split", false)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
-BENCHMARK_CAPTURE(render_benchmark, Render/default/tree_split_all_features, "default", "tree-split", true)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
-BENCHMARK_CAPTURE(render_benchmark, Render/cornell_1k/tree, "cornell-1k", "tree", false)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
-BENCHMARK_CAPTURE(render_benchmark, Render/cornell_1m/tree, "cornell-1m", "tree", false)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
-BENCHMARK_CAPTURE(render_benchmark, Render/cornell_1k/tree_split, "cornell-1k", "tree-split", false)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
-BENCHMARK_CAPTURE(render_benchmark, Render/cornell_1m/tree_split, "cornell-1m", "tree-split", false)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK_CAPTURE(render_benchmark, Render / default / tree_split, "default", "tree-split", false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK_CAPTURE(render_benchmark, Render / default / tree_split_all_features, "default",
+                  "tree-split", true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK_CAPTURE(render_benchmark, Render / cornell_1k / tree, "cornell-1k", "tree", false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK_CAPTURE(render_benchmark, Render / cornell_1m / tree, "cornell-1m", "tree", false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK_CAPTURE(render_benchmark, Render / cornell_1k / tree_split, "cornell-1k", "tree-split",
+                  false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
+BENCHMARK_CAPTURE(render_benchmark, Render / cornell_1m / tree_split, "cornell-1m", "tree-split",
+                  false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);

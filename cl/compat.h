@@ -19,14 +19,24 @@
 #define FLT_INF INFINITY
 #pragma OPENCL FP_CONTRACT OFF
 
-INLINE float4 f4_from3(float3 v, float w) { return (float4)(v, w); }
+INLINE float4 f4_from3(float3 v, float w) {
+  return (float4)(v, w);
+}
 INLINE float f4_get(float4 v, int i) {
   return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w));
 }
-INLINE int i4_get(int4 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w)); }
-INLINE bool is_finite_f(float x) { return isfinite(x); }
-INLINE uint float_as_uint_(float x) { return as_uint(x); }
-INLINE float uint_as_float_(uint x) { return as_float(x); }
+INLINE int i4_get(int4 v, int i) {
+  return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w));
+}
+INLINE bool is_finite_f(float x) {
+  return isfinite(x);
+}
+INLINE uint float_as_uint_(float x) {
+  return as_uint(x);
+}
+INLINE float uint_as_float_(uint x) {
+  return as_float(x);
+}
 
 #else
 // ---------------------------------------------------------------- C++
@@ -61,20 +71,38 @@ struct alignas(8) int2 {
 };
 static_assert(sizeof(float4) == 16 && sizeof(int4) == 16);
 
-INLINE float2 make_float2(float a, float b) { return {a, b}; }
-INLINE float3 make_float3(float a, float b, float c) { return {a, b, c}; }
-INLINE float4 make_float4(float a, float b, float c, float d) { return {a, b, c, d}; }
-INLINE int4 make_int4(int a, int b, int c, int d) { return {a, b, c, d}; }
-INLINE int2 make_int2(int a, int b) { return {a, b}; }
-using std::min;
+INLINE float2 make_float2(float a, float b) {
+  return {a, b};
+}
+INLINE float3 make_float3(float a, float b, float c) {
+  return {a, b, c};
+}
+INLINE float4 make_float4(float a, float b, float c, float d) {
+  return {a, b, c, d};
+}
+INLINE int4 make_int4(int a, int b, int c, int d) {
+  return {a, b, c, d};
+}
+INLINE int2 make_int2(int a, int b) {
+  return {a, b};
+}
 using std::max;
-INLINE float3 xyz_of(float4 v) { return {v.x, v.y, v.z}; }
-INLINE float4 f4_from3(float3 v, float w) { return {v.x, v.y, v.z, w}; }
+using std::min;
+INLINE float3 xyz_of(float4 v) {
+  return {v.x, v.y, v.z};
+}
+INLINE float4 f4_from3(float3 v, float w) {
+  return {v.x, v.y, v.z, w};
+}
 INLINE float f4_get(float4 v, int i) {
   return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w));
 }
-INLINE int i4_get(int4 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w)); }
-INLINE bool is_finite_f(float x) { return std::isfinite(x); }
+INLINE int i4_get(int4 v, int i) {
+  return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w));
+}
+INLINE bool is_finite_f(float x) {
+  return std::isfinite(x);
+}
 INLINE uint float_as_uint_(float x) {
   uint u;
   std::memcpy(&u, &x, 4);
@@ -87,30 +115,60 @@ INLINE float uint_as_float_(uint x) {
 }
 
 // float3
-INLINE float3 operator+(float3 a, float3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-INLINE float3 operator-(float3 a, float3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-INLINE float3 operator*(float3 a, float3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-INLINE float3 operator/(float3 a, float3 b) { return {a.x / b.x, a.y / b.y, a.z / b.z}; }
-INLINE float3 operator*(float3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
-INLINE float3 operator*(float s, float3 a) { return {a.x * s, a.y * s, a.z * s}; }
-INLINE float3 operator/(float3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
-INLINE float3 operator-(float3 a) { return {-a.x, -a.y, -a.z}; }
-INLINE float3& operator+=(float3& a, float3 b) { return a = a + b; }
-INLINE float3& operator*=(float3& a, float3 b) { return a = a * b; }
-INLINE float3& operator*=(float3& a, float s) { return a = a * s; }
-INLINE float dot(float3 a, float3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+INLINE float3 operator+(float3 a, float3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+INLINE float3 operator-(float3 a, float3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+INLINE float3 operator*(float3 a, float3 b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+INLINE float3 operator/(float3 a, float3 b) {
+  return {a.x / b.x, a.y / b.y, a.z / b.z};
+}
+INLINE float3 operator*(float3 a, float s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+INLINE float3 operator*(float s, float3 a) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+INLINE float3 operator/(float3 a, float s) {
+  return {a.x / s, a.y / s, a.z / s};
+}
+INLINE float3 operator-(float3 a) {
+  return {-a.x, -a.y, -a.z};
+}
+INLINE float3& operator+=(float3& a, float3 b) {
+  return a = a + b;
+}
+INLINE float3& operator*=(float3& a, float3 b) {
+  return a = a * b;
+}
+INLINE float3& operator*=(float3& a, float s) {
+  return a = a * s;
+}
+INLINE float dot(float3 a, float3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 INLINE float3 cross(float3 a, float3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-INLINE float length(float3 a) { return std::sqrt(dot(a, a)); }
-INLINE float3 normalize(float3 a) { return a * (1.0f / length(a)); }
+INLINE float length(float3 a) {
+  return std::sqrt(dot(a, a));
+}
+INLINE float3 normalize(float3 a) {
+  return a * (1.0f / length(a));
+}
 INLINE float3 fmin(float3 a, float3 b) {
   return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z)};
 }
 INLINE float3 fmax(float3 a, float3 b) {
   return {std::fmax(a.x, b.x), std::fmax(a.y, b.y), std::fmax(a.z, b.z)};
 }
-INLINE float3 fabs(float3 a) { return {std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)}; }
+INLINE float3 fabs(float3 a) {
+  return {std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)};
+}
 
 // float4 (the 4-wide lanes of the light tree)
 INLINE float4 operator+(float4 a, float4 b) {
@@ -125,9 +183,15 @@ INLINE float4 operator*(float4 a, float4 b) {
 INLINE float4 operator/(float4 a, float4 b) {
   return {a.x / b.x, a.y / b.y, a.z / b.z, a.w / b.w};
 }
-INLINE float4 operator*(float4 a, float s) { return {a.x * s, a.y * s, a.z * s, a.w * s}; }
-INLINE float4 operator-(float4 a, float s) { return {a.x - s, a.y - s, a.z - s, a.w - s}; }
-INLINE float4 operator*(float s, float4 a) { return {a.x * s, a.y * s, a.z * s, a.w * s}; }
+INLINE float4 operator*(float4 a, float s) {
+  return {a.x * s, a.y * s, a.z * s, a.w * s};
+}
+INLINE float4 operator-(float4 a, float s) {
+  return {a.x - s, a.y - s, a.z - s, a.w - s};
+}
+INLINE float4 operator*(float s, float4 a) {
+  return {a.x * s, a.y * s, a.z * s, a.w * s};
+}
 INLINE float4 fmin(float4 a, float4 b) {
   return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z), std::fmin(a.w, b.w)};
 }
@@ -148,9 +212,15 @@ using std::fmax;
 using std::fmin;
 using std::sin;
 using std::sqrt;
-INLINE float clamp(float x, float lo, float hi) { return std::fmin(std::fmax(x, lo), hi); }
-INLINE float mix(float a, float b, float t) { return a + (b - a) * t; }
-INLINE float3 mix(float3 a, float3 b, float t) { return a + (b - a) * t; }
+INLINE float clamp(float x, float lo, float hi) {
+  return std::fmin(std::fmax(x, lo), hi);
+}
+INLINE float mix(float a, float b, float t) {
+  return a + (b - a) * t;
+}
+INLINE float3 mix(float3 a, float3 b, float t) {
+  return a + (b - a) * t;
+}
 #ifndef M_PI_F
 #define M_PI_F 3.14159265358979323846f
 #endif
@@ -160,7 +230,11 @@ INLINE float3 mix(float3 a, float3 b, float t) { return a + (b - a) * t; }
 #define CANOPY_INV_PI (1.0f / M_PI_F)
 
 // max component and luminance (Rec. 709), used as the scalar "energy" of RGB emission.
-INLINE float luminance3(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-INLINE float max3(float3 c) { return fmax(c.x, fmax(c.y, c.z)); }
+INLINE float luminance3(float3 c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
+INLINE float max3(float3 c) {
+  return fmax(c.x, fmax(c.y, c.z));
+}
 
 #endif // CANOPY_CL_COMPAT_H

@@ -13,10 +13,18 @@
 #define BVH_EMPTY (-2147483647 - 1)
 #define BVH_MAX_LEAF 16
 
-INLINE int bvh_is_leaf(int code) { return code < 0 && code != BVH_EMPTY; }
-INLINE int bvh_leaf_first(int code) { return (-1 - code) >> 4; }
-INLINE int bvh_leaf_count(int code) { return ((-1 - code) & 15) + 1; }
-INLINE int bvh_leaf_code(int first, int count) { return -1 - ((first << 4) | (count - 1)); }
+INLINE int bvh_is_leaf(int code) {
+  return code < 0 && code != BVH_EMPTY;
+}
+INLINE int bvh_leaf_first(int code) {
+  return (-1 - code) >> 4;
+}
+INLINE int bvh_leaf_count(int code) {
+  return ((-1 - code) & 15) + 1;
+}
+INLINE int bvh_leaf_code(int first, int count) {
+  return -1 - ((first << 4) | (count - 1));
+}
 
 // Slab test. Returns the entry distance, or INFINITY when the ray misses [tmin, tmax].
 INLINE float ray_box(float3 o, float3 inv_d, float4 bmin, float4 bmax, float tmin, float tmax) {
@@ -77,17 +85,20 @@ INLINE int ray_primitive(const GLOBAL Primitive* prim, float3 o, float3 d, float
     *v = 0.0f;
     return ray_sphere(o, d, xyz_of(prim->v0), prim->v0.w, tmin, tmax, t);
   }
-  return ray_triangle(o, d, xyz_of(prim->v0), xyz_of(prim->e1), xyz_of(prim->e2), tmin, tmax, t,
-                      u, v);
+  return ray_triangle(o, d, xyz_of(prim->v0), xyz_of(prim->e1), xyz_of(prim->e2), tmin, tmax, t, u,
+                      v);
 }
 
 // Entry distances of the ray into the four child boxes of a node (INFINITY: missed or empty).
-INLINE float4 bvh_node_entry(const GLOBAL BvhNode* n, float3 o, float3 inv_d, float tmin, float tmax) {
+INLINE float4 bvh_node_entry(const GLOBAL BvhNode* n, float3 o, float3 inv_d, float tmin,
+                             float tmax) {
   float4 tx0 = (n->min_x - o.x) * inv_d.x, tx1 = (n->max_x - o.x) * inv_d.x;
   float4 ty0 = (n->min_y - o.y) * inv_d.y, ty1 = (n->max_y - o.y) * inv_d.y;
   float4 tz0 = (n->min_z - o.z) * inv_d.z, tz1 = (n->max_z - o.z) * inv_d.z;
-  float4 t0 = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), make_float4(tmin, tmin, tmin, tmin)));
-  float4 t1 = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), make_float4(tmax, tmax, tmax, tmax)));
+  float4 t0 = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)),
+                   fmax(fmin(tz0, tz1), make_float4(tmin, tmin, tmin, tmin)));
+  float4 t1 = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)),
+                   fmin(fmax(tz0, tz1), make_float4(tmax, tmax, tmax, tmax)));
   int4 c = n->child;
   // 1 + 2*gamma(3) widening keeps the test conservative under rounding (pbrt-v4 §6.1.2).
   float4 one = make_float4(1.0000004f, 1.0000004f, 1.0000004f, 1.0000004f);

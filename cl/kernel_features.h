@@ -1,6 +1,7 @@
-// Compile-time features (named kernel_features.h: a bare features.h would shadow glibc's). The host derives them from the scene (host/render/features.cpp) and passes
-// them as -D options, so a kernel contains only the code a scene uses. Without CANOPY_FEATURES_SET
-// (the host reference, C++ tests) everything is on; the kernels then make the same decisions.
+// Compile-time features (named kernel_features.h: a bare features.h would shadow glibc's). The host
+// derives them from the scene (host/render/features.cpp) and passes them as -D options, so a kernel
+// contains only the code a scene uses. Without CANOPY_FEATURES_SET (the host reference, C++ tests)
+// everything is on; the kernels then make the same decisions.
 #ifndef CANOPY_CL_FEATURES_H
 #define CANOPY_CL_FEATURES_H
 

@@ -84,7 +84,8 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
     return s;
   }
   // Quad and triangle: uniform in area, converted to solid angle.
-  if (!((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) || (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)))
+  if (!((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) ||
+        (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)))
     return s;
   float3 q;
   if (HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) {
@@ -111,7 +112,8 @@ INLINE float3 light_emitted_radiance(const GLOBAL Light* l, float3 surface_norma
   if (HAS_LIGHT_SPHERE && l->type == LIGHT_SPHERE) {
     return dot(surface_normal, w_out) > 0.0f ? xyz_of(l->emission) : make_float3(0.0f, 0.0f, 0.0f);
   }
-  if ((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) || (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)) {
+  if ((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) ||
+      (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)) {
     return light_emits_towards(l, w_out) ? xyz_of(l->emission) : make_float3(0.0f, 0.0f, 0.0f);
   }
   return make_float3(0.0f, 0.0f, 0.0f);
@@ -129,7 +131,8 @@ INLINE float light_pdf(const GLOBAL Light* l, float3 P, float3 x) {
     float cos_max = sqrt(fmax(0.0f, 1.0f - sin2_max));
     return 1.0f / (2.0f * CANOPY_PI * (sin2_max / (1.0f + cos_max)));
   }
-  if ((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) || (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)) {
+  if ((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) ||
+      (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)) {
     float3 to = x - P;
     float d2 = dot(to, to);
     if (!(d2 > 0.0f)) return 0.0f;

@@ -36,6 +36,8 @@ INLINE uint rng_next_u32(PathRng* r) {
 }
 
 // Uniform in [0, 1): the top 24 bits, so the result is exactly representable and never 1.
-INLINE float rng_next_float(PathRng* r) { return (float)(rng_next_u32(r) >> 8) * (1.0f / 16777216.0f); }
+INLINE float rng_next_float(PathRng* r) {
+  return (float)(rng_next_u32(r) >> 8) * (1.0f / 16777216.0f);
+}
 
 #endif // CANOPY_CL_RNG_H

@@ -26,6 +26,8 @@ INLINE float3 sample_cosine_hemisphere(float3 n, float u1, float u2) {
 // Origin for a ray leaving a surface at p with normal n (facing the side the ray leaves to).
 // `eps` is the scene's ray offset: 1e-5 x the scene's extent, computed on the host, so the
 // offset scales with the scene and stays hundreds of ulps above the hit point's rounding error.
-INLINE float3 offset_ray_origin(float3 p, float3 n, float eps) { return p + n * eps; }
+INLINE float3 offset_ray_origin(float3 p, float3 n, float eps) {
+  return p + n * eps;
+}
 
 #endif // CANOPY_CL_SHADING_H

@@ -18,10 +18,10 @@
 #define LIGHT_FLAG_FROM_MESH 2 // triangle is part of a mesh already in the geometry
 
 typedef struct Light {
-  float4 p;   // point/spot/sphere: position (xyz), sphere radius (w). quad: corner. triangle: v0.
-  float4 e1;  // quad: edge 1; triangle: v1 - v0; spot: unit axis (xyz), cos of cone half-angle (w)
-  float4 e2;  // quad: edge 2; triangle: v2 - v0; spot: cos of falloff-start half-angle (w)
-  float4 n;   // quad/triangle: unit normal of the emitting face (xyz), area (w)
+  float4 p;  // point/spot/sphere: position (xyz), sphere radius (w). quad: corner. triangle: v0.
+  float4 e1; // quad: edge 1; triangle: v1 - v0; spot: unit axis (xyz), cos of cone half-angle (w)
+  float4 e2; // quad: edge 2; triangle: v2 - v0; spot: cos of falloff-start half-angle (w)
+  float4 n;  // quad/triangle: unit normal of the emitting face (xyz), area (w)
   float4 emission; // rgb: intensity (point/spot) or radiance (area lights)
   int type;
   int flags;

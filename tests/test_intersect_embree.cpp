@@ -20,7 +20,9 @@ namespace {
 
 constexpr int kRays = 100000;
 
-bool close_rel(float a, float b, float rel) { return std::fabs(a - b) <= rel * std::max(std::fabs(a), std::fabs(b)); }
+bool close_rel(float a, float b, float rel) {
+  return std::fabs(a - b) <= rel * std::max(std::fabs(a), std::fabs(b));
+}
 
 class IntersectTest : public ::testing::Test {
 protected:
@@ -29,7 +31,8 @@ protected:
     bvh_ = new Bvh(build_bvh(*prims_));
     rays_ = new Rays(make_rays(*prims_));
     rt_ = new ClRuntime();
-    program_ = new cl::Program(rt_->build_program({"kernels/intersect_closest.cl", "kernels/intersect_shadow.cl"}));
+    program_ = new cl::Program(
+        rt_->build_program({"kernels/intersect_closest.cl", "kernels/intersect_shadow.cl"}));
   }
   static void TearDownTestSuite() {
     delete program_;
@@ -39,8 +42,8 @@ protected:
     delete prims_;
   }
   template <class T> static cl::Buffer buffer(const std::vector<T>& v) {
-    return cl::Buffer(rt_->context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
-                      const_cast<T*>(v.data()));
+    return cl::Buffer(rt_->context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                      v.size() * sizeof(T), const_cast<T*>(v.data()));
   }
   static inline std::vector<Primitive>* prims_;
   static inline Bvh* bvh_;
@@ -57,7 +60,8 @@ std::vector<Hit> run_closest(ClRuntime& rt, cl::Program& program, const Bvh& bvh
                       const_cast<T*>(v.data()));
   };
   std::vector<int> queue(rays.o.size());
-  for (size_t i = 0; i < queue.size(); ++i) queue[i] = int(i);
+  for (size_t i = 0; i < queue.size(); ++i)
+    queue[i] = int(i);
   std::vector<Hit> hits(rays.o.size());
   cl::Buffer b_nodes = buf(bvh.nodes), b_idx = buf(bvh.prim_index), b_prims = buf(prims),
              b_queue = buf(queue), b_o = buf(rays.o), b_d = buf(rays.d), b_hits = buf(hits);
@@ -96,28 +100,34 @@ TEST_F(IntersectTest, BvhIsWellFormed) {
         int p = bvh_->prim_index[size_t(bvh_leaf_first(c) + i)];
         seen[size_t(p)]++;
         const Primitive& pr = (*prims_)[size_t(p)];
-        for (float3 v : {xyz_of(pr.v0), xyz_of(pr.v0) + xyz_of(pr.e1), xyz_of(pr.v0) + xyz_of(pr.e2)}) {
+        for (float3 v :
+             {xyz_of(pr.v0), xyz_of(pr.v0) + xyz_of(pr.e1), xyz_of(pr.v0) + xyz_of(pr.e2)}) {
           // the leaf's box (the lane's box) contains its triangles
-          ASSERT_TRUE(v.x >= lo.x && v.y >= lo.y && v.z >= lo.z && v.x <= hi.x && v.y <= hi.y && v.z <= hi.z);
+          ASSERT_TRUE(v.x >= lo.x && v.y >= lo.y && v.z >= lo.z && v.x <= hi.x && v.y <= hi.y &&
+                      v.z <= hi.z);
         }
       }
     }
-  for (size_t p = 0; p < seen.size(); ++p) ASSERT_EQ(seen[p], 1) << "primitive " << p;
+  for (size_t p = 0; p < seen.size(); ++p)
+    ASSERT_EQ(seen[p], 1) << "primitive " << p;
   EXPECT_EQ(parents[0], 0);
-  for (size_t i = 1; i < parents.size(); ++i) ASSERT_EQ(parents[i], 1) << "node " << i;
+  for (size_t i = 1; i < parents.size(); ++i)
+    ASSERT_EQ(parents[i], 1) << "node " << i;
 }
 
 TEST_F(IntersectTest, ClosestHitMatchesEmbreeAndHostTraversal) {
   std::vector<Hit> hits = run_closest(*rt_, *program_, *bvh_, *prims_, *rays_);
   EmbreeReference embree(*prims_);
-  int hit_count = 0, grazing = 0, edge_ties = 0, miss_disagree = 0, t_disagree = 0, host_disagree = 0;
+  int hit_count = 0, grazing = 0, edge_ties = 0, miss_disagree = 0, t_disagree = 0,
+      host_disagree = 0;
   for (int i = 0; i < kRays; ++i) {
     float3 o = xyz_of(rays_->o[size_t(i)]), d = xyz_of(rays_->d[size_t(i)]);
     float te = 0.0f;
     int pe = embree.intersect(o, d, 0.0f, FLT_INF, &te);
     const Hit& h = hits[size_t(i)];
     Hit hh;
-    bvh_intersect(bvh_->nodes.data(), bvh_->prim_index.data(), prims_->data(), o, d, 0.0f, FLT_INF, 0, &hh);
+    bvh_intersect(bvh_->nodes.data(), bvh_->prim_index.data(), prims_->data(), o, d, 0.0f, FLT_INF,
+                  0, &hh);
     if (hh.prim != h.prim || hh.t != h.t) ++host_disagree;
     if (pe >= 0) ++hit_count;
     if ((pe < 0) != (h.prim < 0)) {
@@ -135,8 +145,8 @@ TEST_F(IntersectTest, ClosestHitMatchesEmbreeAndHostTraversal) {
     grazing += cosv < 1e-2f;
     if (!close_rel(h.t, te, tol)) {
       ++t_disagree;
-      ADD_FAILURE() << "ray " << i << ": kernel t=" << h.t << " prim " << h.prim << ", embree t=" << te
-                    << " prim " << pe << ", cos=" << cosv;
+      ADD_FAILURE() << "ray " << i << ": kernel t=" << h.t << " prim " << h.prim
+                    << ", embree t=" << te << " prim " << pe << ", cos=" << cosv;
     } else if (pe != h.prim) {
       ++edge_ties; // same distance, neighbouring triangle: the ray passes through a shared edge
     }
@@ -171,8 +181,8 @@ TEST_F(IntersectTest, OcclusionMatchesEmbree) {
     s.dir.w = uint_as_float_(uint(i));
     s.contribution = make_float4(1, 1, 1, 0);
   }
-  cl::Buffer b_nodes = buffer(bvh_->nodes), b_idx = buffer(bvh_->prim_index), b_prims = buffer(*prims_),
-             b_items = buffer(items);
+  cl::Buffer b_nodes = buffer(bvh_->nodes), b_idx = buffer(bvh_->prim_index),
+             b_prims = buffer(*prims_), b_items = buffer(items);
   cl::Kernel k(*program_, "intersect_shadow");
   k.setArg(0, b_nodes);
   k.setArg(1, b_idx);
@@ -181,7 +191,8 @@ TEST_F(IntersectTest, OcclusionMatchesEmbree) {
   k.setArg(4, cl_int(kRays));
   enqueue_1d(rt_->queue(), k, size_t(kRays));
   std::vector<ShadowItem> result(items.size());
-  rt_->queue().enqueueReadBuffer(b_items, CL_TRUE, 0, result.size() * sizeof(ShadowItem), result.data());
+  rt_->queue().enqueueReadBuffer(b_items, CL_TRUE, 0, result.size() * sizeof(ShadowItem),
+                                 result.data());
   int occluded = 0, disagree = 0;
   for (int i = 0; i < kRays; ++i) {
     const ShadowItem& s = items[size_t(i)];

@@ -60,7 +60,8 @@ constexpr int kPaths = 4096;
 template <class T> cl::Buffer to_device(ClRuntime& rt, const std::vector<T>& v) {
   size_t bytes = std::max<size_t>(1, v.size()) * sizeof(T);
   if (v.empty()) return cl::Buffer(rt.context(), CL_MEM_READ_WRITE, bytes);
-  return cl::Buffer(rt.context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(v.data()));
+  return cl::Buffer(rt.context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes,
+                    const_cast<T*>(v.data()));
 }
 template <class T> std::vector<T> from_device(ClRuntime& rt, const cl::Buffer& b, size_t n) {
   std::vector<T> v(n);
@@ -87,8 +88,8 @@ struct Paths {
   std::vector<uint32_t> rng;
   std::vector<Hit> hits;
   PathBuffers host() {
-    return PathBuffers{ray_o.data(),   ray_d.data(),   throughput.data(), radiance.data(), rng.data(),
-                       hits.data(),    shade_P.data(), shade_N.data(),    shade_f.data()};
+    return PathBuffers{ray_o.data(), ray_d.data(),   throughput.data(), radiance.data(), rng.data(),
+                       hits.data(),  shade_P.data(), shade_N.data(),    shade_f.data()};
   }
 };
 
@@ -96,7 +97,8 @@ class KernelStages : public ::testing::TestWithParam<std::string> {
 protected:
   void SetUp() override {
     scene_ = load_scene_from_string(kSceneJson, "kernel-test.json", ".");
-    for (const MaterialDesc& m : scene_.materials) materials_.push_back(m.gpu);
+    for (const MaterialDesc& m : scene_.materials)
+      materials_.push_back(m.gpu);
     geometry_ = build_scene_geometry(scene_, materials_);
     sampler_ = make_light_sampler_data(scene_.lights, GetParam(), 0.85f, 16);
     program_ = rt_.build_program(wavefront_kernel_files(),
@@ -114,8 +116,8 @@ protected:
       float z = 2 * u(rng) - 1, phi = 6.2831853f * u(rng), s = std::sqrt(std::max(0.0f, 1 - z * z));
       float3 d = make_float3(s * std::cos(phi), z, s * std::sin(phi));
       Hit h;
-      bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(), geometry_.prims.data(), o, d,
-                    0.0f, FLT_INF, 0, &h);
+      bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
+                    geometry_.prims.data(), o, d, 0.0f, FLT_INF, 0, &h);
       p.ray_o.push_back(f4_from3(o, 0));
       p.ray_d.push_back(f4_from3(d, 0));
       p.hits.push_back(h);
@@ -123,7 +125,8 @@ protected:
       p.radiance.push_back(make_float4(u(rng), u(rng), u(rng), 0));
       p.rng.push_back(uint32_t(rng()));
       // Previous vertex: a point in the room, a normal, and the pdf of the BSDF ray (0: none).
-      p.shade_P.push_back(make_float4(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng), i % 3 == 0 ? 0.0f : u(rng)));
+      p.shade_P.push_back(make_float4(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng),
+                                      i % 3 == 0 ? 0.0f : u(rng)));
       p.shade_N.push_back(f4_from3(normalize(make_float3(u(rng) - 0.5f, 1.0f, u(rng) - 0.5f)), 0));
       p.shade_f.push_back(make_float4(0, 0, 0, 0));
     }
@@ -134,7 +137,7 @@ protected:
     cl::Buffer ray_o, ray_d, throughput, radiance, rng, hits, shade_P, shade_N, shade_f;
   };
   DevicePaths upload(const Paths& p) {
-    return {to_device(rt_, p.ray_o),   to_device(rt_, p.ray_d),   to_device(rt_, p.throughput),
+    return {to_device(rt_, p.ray_o),    to_device(rt_, p.ray_d),   to_device(rt_, p.throughput),
             to_device(rt_, p.radiance), to_device(rt_, p.rng),     to_device(rt_, p.hits),
             to_device(rt_, p.shade_P),  to_device(rt_, p.shade_N), to_device(rt_, p.shade_f)};
   }
@@ -152,8 +155,8 @@ protected:
     return p;
   }
   int set_path_args(cl::Kernel& k, int i, const DevicePaths& d) {
-    for (const cl::Buffer* b : {&d.ray_o, &d.ray_d, &d.throughput, &d.radiance, &d.rng, &d.hits, &d.shade_P,
-                                &d.shade_N, &d.shade_f})
+    for (const cl::Buffer* b : {&d.ray_o, &d.ray_d, &d.throughput, &d.radiance, &d.rng, &d.hits,
+                                &d.shade_P, &d.shade_N, &d.shade_f})
       k.setArg(i++, *b);
     return i;
   }
@@ -196,8 +199,8 @@ protected:
     buf_lt_trails_ = to_device(rt_, sampler_.tree.trails);
   }
   SceneBuffers host_scene() {
-    return SceneBuffers{geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(), geometry_.prims.data(),
-                        materials_.data(), geometry_.ray_eps};
+    return SceneBuffers{geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
+                        geometry_.prims.data(), materials_.data(), geometry_.ray_eps};
   }
 
   ClRuntime rt_;
@@ -207,7 +210,8 @@ protected:
   LightSamplerData sampler_;
   cl::Program program_;
   cl::Buffer buf_nodes_, buf_prim_index_, buf_prims_, buf_materials_, buf_lights_, buf_power_pmf_,
-      buf_alias_prob_, buf_alias_index_, buf_lt_nodes_, buf_lt_children_, buf_lt_leaf_, buf_lt_trails_;
+      buf_alias_prob_, buf_alias_index_, buf_lt_nodes_, buf_lt_children_, buf_lt_leaf_,
+      buf_lt_trails_;
 };
 
 void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& which) {
@@ -235,16 +239,19 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
   SceneBuffers sc = host_scene();
   Paths paths = make_paths(17);
   std::vector<int> queue(kPaths);
-  for (int i = 0; i < kPaths; ++i) queue[size_t(i)] = (i * 7919) % kPaths; // a permutation
+  for (int i = 0; i < kPaths; ++i)
+    queue[size_t(i)] = (i * 7919) % kPaths; // a permutation
   int hits = 0;
-  for (const Hit& h : paths.hits) hits += h.prim >= 0;
+  for (const Hit& h : paths.hits)
+    hits += h.prim >= 0;
   ASSERT_GT(hits, kPaths * 9 / 10);
 
   for (int depth : {0, 1, 2}) {
     SCOPED_TRACE("depth " + std::to_string(depth));
     // ---- shade_surface: device
     DevicePaths d = upload(paths);
-    cl::Buffer b_queue = to_device(rt_, queue), b_counts(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2));
+    cl::Buffer b_queue = to_device(rt_, queue),
+               b_counts(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2));
     cl::Kernel k(program_, "shade_surface");
     int a = 0;
     k.setArg(a++, cl_int(depth));
@@ -262,14 +269,16 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     Paths ref = paths;
     PathBuffers pb = ref.host();
     std::vector<int2> ref_counts(kPaths);
-    for (int i = 0; i < kPaths; ++i) ref_counts[size_t(i)] = shade_surface_item(queue[size_t(i)], depth, 3, &sc, &pb, &ls);
+    for (int i = 0; i < kPaths; ++i)
+      ref_counts[size_t(i)] = shade_surface_item(queue[size_t(i)], depth, 3, &sc, &pb, &ls);
     int continues = 0, shaded = 0, emission_hits = 0;
     for (int i = 0; i < kPaths; ++i) {
       ASSERT_EQ(dev_counts[size_t(i)].x, ref_counts[size_t(i)].x) << "item " << i;
       ASSERT_EQ(dev_counts[size_t(i)].y, ref_counts[size_t(i)].y) << "item " << i;
       continues += ref_counts[size_t(i)].x;
       shaded += ref_counts[size_t(i)].y;
-      emission_hits += paths.hits[size_t(i)].prim >= 0 && geometry_.prims[size_t(paths.hits[size_t(i)].prim)].light >= 0;
+      emission_hits += paths.hits[size_t(i)].prim >= 0 &&
+                       geometry_.prims[size_t(paths.hits[size_t(i)].prim)].light >= 0;
     }
     compare_paths(dev, ref, queue);
     EXPECT_GT(shaded, kPaths / 2);
@@ -368,7 +377,8 @@ INSTANTIATE_TEST_SUITE_P(Samplers, KernelStages,
 class KernelUtilities : public ::testing::Test {
 protected:
   void SetUp() override {
-    program_ = rt_.build_program(wavefront_kernel_files(), KernelFeatures::all(SAMPLER_UNIFORM).build_options());
+    program_ = rt_.build_program(wavefront_kernel_files(),
+                                 KernelFeatures::all(SAMPLER_UNIFORM).build_options());
   }
   ClRuntime rt_;
   cl::Program program_;
@@ -384,8 +394,8 @@ TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
   std::vector<CameraParams> cp = {make_camera_params(cam, w, h)};
   cl::Buffer b_cam = to_device(rt_, cp);
   std::vector<cl::Buffer> out;
-  for (size_t bytes : {sizeof(float4), sizeof(float4), sizeof(float4), sizeof(float4), sizeof(uint32_t), sizeof(int),
-                       sizeof(int2)})
+  for (size_t bytes : {sizeof(float4), sizeof(float4), sizeof(float4), sizeof(float4),
+                       sizeof(uint32_t), sizeof(int), sizeof(int2)})
     out.emplace_back(rt_.context(), CL_MEM_READ_WRITE, n * bytes);
   cl::Kernel k(program_, "generate");
   int a = 0;
@@ -393,7 +403,8 @@ TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
   k.setArg(a++, cl_uint(99));
   k.setArg(a++, cl_ulong(base));
   k.setArg(a++, cl_int(n));
-  for (cl::Buffer& b : out) k.setArg(a++, b);
+  for (cl::Buffer& b : out)
+    k.setArg(a++, b);
   enqueue_1d(rt_.queue(), k, n);
   auto o = from_device<float4>(rt_, out[0], n), d = from_device<float4>(rt_, out[1], n);
   auto rng = from_device<uint32_t>(rt_, out[4], n);
@@ -431,11 +442,13 @@ TEST_F(KernelUtilities, AccumulateSumsEachPixelsSamplesInOrderAndDropsNonFinite)
   }
   radiance[7].y = std::numeric_limits<float>::quiet_NaN();
   radiance[90].z = std::numeric_limits<float>::infinity();
-  std::vector<float4> sum(npix, make_float4(1, 1, 1, 2)), sumsq(npix, make_float4(0.5f, 0.5f, 0.5f, 0));
+  std::vector<float4> sum(npix, make_float4(1, 1, 1, 2)),
+      sumsq(npix, make_float4(0.5f, 0.5f, 0.5f, 0));
   std::vector<float2> fc(npix, float2{0, 0});
   std::vector<int> nonfinite = {0};
   cl::Buffer b_r = to_device(rt_, radiance), b_s = to_device(rt_, sum), b_q = to_device(rt_, sumsq),
-             b_n = to_device(rt_, nonfinite), b_c = to_device(rt_, counts), b_fc = to_device(rt_, fc);
+             b_n = to_device(rt_, nonfinite), b_c = to_device(rt_, counts),
+             b_fc = to_device(rt_, fc);
   cl::Kernel k(program_, "accumulate");
   int a = 0;
   k.setArg(a++, cl_ulong(base));
@@ -455,9 +468,11 @@ TEST_F(KernelUtilities, AccumulateSumsEachPixelsSamplesInOrderAndDropsNonFinite)
   for (int i = 0; i < wave; ++i) {
     size_t p = size_t((base + uint64_t(i)) % npix);
     float4 L = radiance[size_t(i)];
-    if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) L = make_float4(0, 0, 0, 0);
+    if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z))
+      L = make_float4(0, 0, 0, 0);
     sum[p] = make_float4(sum[p].x + L.x, sum[p].y + L.y, sum[p].z + L.z, sum[p].w + 1);
-    sumsq[p] = make_float4(sumsq[p].x + L.x * L.x, sumsq[p].y + L.y * L.y, sumsq[p].z + L.z * L.z, 0);
+    sumsq[p] =
+        make_float4(sumsq[p].x + L.x * L.x, sumsq[p].y + L.y * L.y, sumsq[p].z + L.z * L.z, 0);
     fc[p].x += float(counts[size_t(i)].x);
     fc[p].y += float(counts[size_t(i)].y);
   }
@@ -489,10 +504,12 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
     }
   }
   int blocks = (n + block - 1) / block;
-  cl::Buffer b_c = to_device(rt_, counts), b_off(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2)),
+  cl::Buffer b_c = to_device(rt_, counts),
+             b_off(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2)),
              b_bs(rt_.context(), CL_MEM_READ_WRITE, size_t(blocks) * sizeof(int2)),
              b_tot(rt_.context(), CL_MEM_READ_WRITE, 2 * sizeof(int));
-  cl::Kernel ks(program_, "scan_blocks"), kb(program_, "scan_block_sums"), kx(program_, "scatter_split");
+  cl::Kernel ks(program_, "scan_blocks"), kb(program_, "scan_block_sums"),
+      kx(program_, "scatter_split");
   ks.setArg(0, b_c);
   ks.setArg(1, cl_int(n));
   ks.setArg(2, cl_int(block));
@@ -507,8 +524,10 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
   std::vector<SplitItem> ref_split;
   std::vector<ShadowItem> ref_shadow;
   for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < counts[size_t(i)].x; ++j) ref_split.push_back(child[size_t(4 * i + j)]);
-    for (int j = 0; j < counts[size_t(i)].y; ++j) ref_shadow.push_back(shadow[size_t(4 * i + j)]);
+    for (int j = 0; j < counts[size_t(i)].x; ++j)
+      ref_split.push_back(child[size_t(4 * i + j)]);
+    for (int j = 0; j < counts[size_t(i)].y; ++j)
+      ref_shadow.push_back(shadow[size_t(4 * i + j)]);
   }
   ASSERT_EQ(tot[0], int(ref_split.size()));
   ASSERT_EQ(tot[1], int(ref_shadow.size()));
@@ -528,8 +547,10 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
   enqueue_1d(rt_.queue(), kx, size_t(n));
   auto so = from_device<SplitItem>(rt_, b_so, ref_split.size());
   auto sh = from_device<ShadowItem>(rt_, b_sh, ref_shadow.size());
-  for (size_t i = 0; i < so.size(); ++i) ASSERT_EQ(so[i].code, ref_split[i].code) << i;
-  for (size_t i = 0; i < sh.size(); ++i) ASSERT_EQ(sh[i].contribution.x, ref_shadow[i].contribution.x) << i;
+  for (size_t i = 0; i < so.size(); ++i)
+    ASSERT_EQ(so[i].code, ref_split[i].code) << i;
+  for (size_t i = 0; i < sh.size(); ++i)
+    ASSERT_EQ(sh[i].contribution.x, ref_shadow[i].contribution.x) << i;
 
   // accumulate_shadow: each path's run of items is summed in order into its radiance.
   const int paths = n / 3 + 1;

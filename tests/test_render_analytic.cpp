@@ -35,7 +35,8 @@ Scene make_plane_scene(float scale, const std::vector<PointLight>& lights, float
   m.gpu.type = MATERIAL_DIFFUSE;
   s.materials.push_back(m);
   float e = 20.0f * scale;
-  s.vertices = {make_float3(-e, -e, 0), make_float3(e, -e, 0), make_float3(e, e, 0), make_float3(-e, e, 0)};
+  s.vertices = {make_float3(-e, -e, 0), make_float3(e, -e, 0), make_float3(e, e, 0),
+                make_float3(-e, e, 0)};
   s.indices = {0, 1, 2, 0, 2, 3};
   s.triangle_material = {0, 0};
   s.triangle_light = {-1, -1};
@@ -63,11 +64,13 @@ float3 plane_radiance(const Scene& s, float3 x, float3 albedo) {
 }
 
 // The pixel's box-filtered radiance by an n x n midpoint rule over the footprint.
-float3 pixel_reference(const Scene& s, const CameraParams& cam, int px, int py, int n, float3 albedo) {
+float3 pixel_reference(const Scene& s, const CameraParams& cam, int px, int py, int n,
+                       float3 albedo) {
   float3 acc = make_float3(0, 0, 0);
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) {
-      float x = float(px) + (float(a) + 0.5f) / float(n), y = float(py) + (float(b) + 0.5f) / float(n);
+      float x = float(px) + (float(a) + 0.5f) / float(n),
+            y = float(py) + (float(b) + 0.5f) / float(n);
       float3 d = normalize(xyz_of(cam.lower_left) + xyz_of(cam.du) * x + xyz_of(cam.dv) * y);
       float3 o = xyz_of(cam.origin);
       float t = -o.z / d.z;
@@ -102,15 +105,16 @@ Check compare_with_analytic(const Scene& scene, const Film& film, float3 albedo)
         double var = std::max(0.0, sq[ch] / n - mean * mean) * n / (n - 1.0);
         // 5 standard errors of the mean, plus the quadrature error of the reference (bounded by
         // the difference between the 8x8 and 16x16 rules) and float accumulation error.
-        double bound = 5.0 * std::sqrt(var / n) + std::fabs(double(r[ch]) - double(rc[ch])) + 1e-5 * std::fabs(r[ch]);
+        double bound = 5.0 * std::sqrt(var / n) + std::fabs(double(r[ch]) - double(rc[ch])) +
+                       1e-5 * std::fabs(r[ch]);
         c.total_mean += mean;
         c.total_ref += r[ch];
         c.total_var += var / n;
         c.total_quad += std::fabs(double(r[ch]) - double(rc[ch]));
         if (std::fabs(mean - r[ch]) > bound) {
           if (c.violations < 10)
-            ADD_FAILURE() << "pixel (" << x << "," << y << ") ch " << ch << ": mean " << mean << " vs analytic "
-                          << r[ch] << ", bound " << bound;
+            ADD_FAILURE() << "pixel (" << x << "," << y << ") ch " << ch << ": mean " << mean
+                          << " vs analytic " << r[ch] << ", bound " << bound;
           ++c.violations;
         }
         if (r[ch] > 0) {
@@ -150,9 +154,11 @@ TEST_P(AnalyticPlane, PixelMeansMatchTheAnalyticRadiance) {
   rs.wave_size = 1 << 14; // several waves, each holding many samples of every pixel
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
-  for (const float4& s : film.sum) ASSERT_EQ(s.w, 2048.0f);
+  for (const float4& s : film.sum)
+    ASSERT_EQ(s.w, 2048.0f);
   Check c = compare_with_analytic(scene, film, albedo);
-  std::printf("%s, scale %g: %d values checked, mean relative bound %.4f\n", sampler.c_str(), double(scale), c.checked, c.mean_rel_bound);
+  std::printf("%s, scale %g: %d values checked, mean relative bound %.4f\n", sampler.c_str(),
+              double(scale), c.checked, c.mean_rel_bound);
   EXPECT_EQ(c.violations, 0);
   double total_bound = 5.0 * std::sqrt(c.total_var) + c.total_quad + 1e-5 * c.total_ref;
   std::printf("image total %.6g vs analytic %.6g (bound %.3g, %.3f%%)\n", c.total_mean, c.total_ref,
@@ -164,17 +170,18 @@ TEST_P(AnalyticPlane, PixelMeansMatchTheAnalyticRadiance) {
   EXPECT_LT(c.mean_rel_bound, 0.2);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    SamplersAndScales, AnalyticPlane,
-    ::testing::Combine(::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive"),
-                       ::testing::Values(1.0f, 1e-3f, 1e3f)),
-    [](const auto& p) {
-      std::string name = std::get<0>(p.param) + "_scale_" +
-                         std::to_string(int(std::log10(std::get<1>(p.param)) + 3.5f) - 3);
-      for (char& c : name)
-        if (c == '-') c = '_';
-      return name;
-    });
+INSTANTIATE_TEST_SUITE_P(SamplersAndScales, AnalyticPlane,
+                         ::testing::Combine(::testing::Values("uniform", "power", "tree",
+                                                              "tree-split", "exhaustive"),
+                                            ::testing::Values(1.0f, 1e-3f, 1e3f)),
+                         [](const auto& p) {
+                           std::string name =
+                               std::get<0>(p.param) + "_scale_" +
+                               std::to_string(int(std::log10(std::get<1>(p.param)) + 3.5f) - 3);
+                           for (char& c : name)
+                             if (c == '-') c = '_';
+                           return name;
+                         });
 
 TEST(AnalyticPlaneDeterminism, SameSeedSameImage) {
   const float3 albedo = make_float3(0.5f, 0.5f, 0.5f);
@@ -203,9 +210,9 @@ TEST(AnalyticPlaneDeterminism, SameSeedSameImage) {
 namespace {
 
 // Irradiance at plane point x (normal +z) from light l, exactly: Lambert's formula for a polygon
-// entirely above the horizon, E = L/2 |sum_i theta_i (n . normalize(v_i x v_i+1))| with v_i the unit
-// vectors to its vertices (both test polygons face the plane), and E = L pi (r/d)^2 cos(theta) for a
-// sphere entirely above the horizon. Evaluated in double.
+// entirely above the horizon, E = L/2 |sum_i theta_i (n . normalize(v_i x v_i+1))| with v_i the
+// unit vectors to its vertices (both test polygons face the plane), and E = L pi (r/d)^2 cos(theta)
+// for a sphere entirely above the horizon. Evaluated in double.
 float3 area_light_irradiance(const Light& l, float3 x) {
   float3 L = xyz_of(l.emission);
   if (l.type == LIGHT_SPHERE) {
@@ -223,7 +230,8 @@ float3 area_light_irradiance(const Light& l, float3 x) {
     double a[3] = {a3.x, a3.y, a3.z}, b[3] = {b3.x, b3.y, b3.z};
     double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     double lb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-    for (int k = 0; k < 3; ++k) a[k] /= la, b[k] /= lb;
+    for (int k = 0; k < 3; ++k)
+      a[k] /= la, b[k] /= lb;
     double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
     double lc = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     double theta = std::atan2(lc, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
@@ -307,11 +315,14 @@ TEST_P(AreaLightMis, PixelMeansMatchTheIrradianceIntegral) {
       for (int n : {16, 3, 6})
         for (int a = 0; a < n; ++a)
           for (int b = 0; b < n; ++b) {
-            float fx = float(x) + (float(a) + 0.5f) / float(n), fy = float(y) + (float(b) + 0.5f) / float(n);
-            float3 d = normalize(xyz_of(cam.lower_left) + xyz_of(cam.du) * fx + xyz_of(cam.dv) * fy);
+            float fx = float(x) + (float(a) + 0.5f) / float(n),
+                  fy = float(y) + (float(b) + 0.5f) / float(n);
+            float3 d =
+                normalize(xyz_of(cam.lower_left) + xyz_of(cam.du) * fx + xyz_of(cam.dv) * fy);
             float3 o = xyz_of(cam.origin);
             Hit h;
-            bvh_intersect(g.bvh.nodes.data(), g.bvh.prim_index.data(), g.prims.data(), o, d, 0, FLT_INF, 0, &h);
+            bvh_intersect(g.bvh.nodes.data(), g.bvh.prim_index.data(), g.prims.data(), o, d, 0,
+                          FLT_INF, 0, &h);
             if (h.prim < 0 || g.prims[size_t(h.prim)].light >= 0) {
               sees_light = true;
               continue;
@@ -348,8 +359,9 @@ TEST_P(AreaLightMis, PixelMeansMatchTheIrradianceIntegral) {
       ++checked;
     }
   double total_bound = 5.0 * std::sqrt(total_var) + total_quad + 1e-4 * total_ref;
-  std::printf("light %d, max_depth %d: %d pixels, total %.5g vs %.5g (bound %.3g = %.2f%%)\n", which, max_depth,
-              checked, total_mean, total_ref, total_bound, 100.0 * total_bound / total_ref);
+  std::printf("light %d, max_depth %d: %d pixels, total %.5g vs %.5g (bound %.3g = %.2f%%)\n",
+              which, max_depth, checked, total_mean, total_ref, total_bound,
+              100.0 * total_bound / total_ref);
   EXPECT_GT(checked, 300);
   EXPECT_LE(violations, 1); // 6-sigma per pixel (and a rare quadrature outlier near a light's edge)
   EXPECT_NEAR(total_mean, total_ref, total_bound);

@@ -38,7 +38,8 @@ void expect_identical(const Film& a, const Film& b) {
     differ += a.sum[i].x != b.sum[i].x || a.sum[i].y != b.sum[i].y || a.sum[i].z != b.sum[i].z;
   EXPECT_EQ(differ, 0) << "pixels that differ";
   double total = 0;
-  for (const float4& s : a.sum) total += s.x + s.y + s.z;
+  for (const float4& s : a.sum)
+    total += s.x + s.y + s.z;
   EXPECT_GT(total, 0.0); // the image is not black
 }
 
@@ -69,4 +70,7 @@ TEST_P(RenderFeatures, RendersAreBitIdenticalAcrossRunsAndWaveSizes) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Samplers, RenderFeatures, ::testing::Values("tree", "tree-split"),
-                         [](const auto& p) { return p.param == "tree" ? std::string("tree") : std::string("tree_split"); });
+                         [](const auto& p) {
+                           return p.param == "tree" ? std::string("tree")
+                                                    : std::string("tree_split");
+                         });

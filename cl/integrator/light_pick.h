@@ -15,8 +15,8 @@
 // Samples a point on `light` (chosen with probability pmf) from the path's shading point and, if
 // it can contribute, writes the shadow item. Returns 1 if an item was written.
 INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers* sc,
-                                  const PathBuffers* pb, int path, int light, float pmf,
-                                  LtRng* rng, GLOBAL ShadowItem* out) {
+                                  const PathBuffers* pb, int path, int light, float pmf, LtRng* rng,
+                                  GLOBAL ShadowItem* out) {
   float3 P = xyz_of(pb->shade_P[path]);
   float3 N = xyz_of(pb->shade_N[path]);
   float4 f = pb->shade_f[path];

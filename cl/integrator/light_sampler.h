@@ -11,12 +11,12 @@ typedef struct LightSamplerCtx {
   int kind; // SAMPLER_*
   int light_count;
   GLOBAL const Light* lights;
-  GLOBAL const float* power_pmf;   // power: probability of each light
-  GLOBAL const float* alias_prob;  // power: alias table (Walker/Vose)
+  GLOBAL const float* power_pmf;  // power: probability of each light
+  GLOBAL const float* alias_prob; // power: alias table (Walker/Vose)
   GLOBAL const int* alias_index;
-  LtTree tree;                     // tree, tree-split, exhaustive
-  float threshold;                 // tree-split: split while the measure is below it (>= 1: always)
-  uint max_cut;                    // tree-split: cut size cap per shading point
+  LtTree tree;     // tree, tree-split, exhaustive
+  float threshold; // tree-split: split while the measure is below it (>= 1: always)
+  uint max_cut;    // tree-split: cut size cap per shading point
 } LightSamplerCtx;
 
 // The split-queue root item of a shading point.
@@ -59,8 +59,7 @@ INLINE float light_sampler_pmf(const LightSamplerCtx* ls, float3 P, float3 N, in
   if (ls->light_count <= 0) return 0.0f;
   if (ls->kind == SAMPLER_UNIFORM) return 1.0f / (float)ls->light_count;
   if (ls->kind == SAMPLER_POWER) return ls->power_pmf[light];
-  if (ls->kind == SAMPLER_TREE)
-    return lt_pmf_below(&ls->tree, 0, P, N, ls->tree.trails[light]);
+  if (ls->kind == SAMPLER_TREE) return lt_pmf_below(&ls->tree, 0, P, N, ls->tree.trails[light]);
   return lt_pmf_split(&ls->tree, P, N, light, ls->threshold, ls->max_cut);
 }
 

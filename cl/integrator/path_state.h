@@ -16,8 +16,9 @@ typedef struct PathBuffers {
   // The last shading point, kept for light picking in this bounce and for MIS at the next hit.
   GLOBAL float4* shade_P; // xyz: position, w: solid-angle pdf of the BSDF direction that left it
   GLOBAL float4* shade_N; // xyz: normal facing the incoming ray, w: light-pick seed (uint bits)
-  GLOBAL float4* shade_f; // xyz: beta * BSDF value (diffuse: albedo/pi), w: 1 if BSDF sampling
-                          // continues the path (MIS on), 0 at the last vertex (light sampling alone)
+  GLOBAL float4*
+      shade_f; // xyz: beta * BSDF value (diffuse: albedo/pi), w: 1 if BSDF sampling
+               // continues the path (MIS on), 0 at the last vertex (light sampling alone)
 } PathBuffers;
 
 typedef struct SceneBuffers {

@@ -41,14 +41,14 @@
   sc.ray_eps = ray_eps
 
 #define LIGHT_SAMPLER_PARAMS                                                                       \
-  int light_count, __global const Light *lights, __global const float *power_pmf,                 \
+  int light_count, __global const Light *lights, __global const float *power_pmf,                  \
       __global const float *alias_prob, __global const int *alias_index,                           \
       __global const float4 *lt_nodes, __global const int4 *lt_children,                           \
       __global const int *lt_leaf_lights, __global const uint *lt_trails, float4 lt_root_sphere,   \
       float4 lt_root_info, float split_threshold, uint max_cut
 
 #define LIGHT_SAMPLER_ASSEMBLE(ls)                                                                 \
-  LightSamplerCtx ls;                                                                                 \
+  LightSamplerCtx ls;                                                                              \
   ls.kind = CANOPY_LIGHT_SAMPLER;                                                                  \
   ls.light_count = light_count;                                                                    \
   ls.lights = lights;                                                                              \

@@ -12,7 +12,6 @@ namespace canopy {
 
 namespace {
 
-
 Primitive make_triangle(float3 a, float3 b, float3 c, int material, int light) {
   Primitive p{};
   p.v0 = f4_from3(a, 0.0f);
@@ -40,10 +39,10 @@ void primitive_bounds(const Primitive& p, float3& lo, float3& hi) {
 // Temporary tree produced by Embree's callbacks (allocated in Embree's thread-local arenas).
 struct BuildNode {
   bool leaf;
-  int count;             // leaf: primitive count; interior: child count
-  RTCBounds bounds[4];   // interior: child bounds
+  int count;           // leaf: primitive count; interior: child count
+  RTCBounds bounds[4]; // interior: child bounds
   BuildNode* children[4];
-  const unsigned* ids;   // leaf: primitive ids
+  const unsigned* ids; // leaf: primitive ids
 };
 
 void* create_node(RTCThreadLocalAllocator alloc, unsigned int count, void*) {
@@ -55,19 +54,23 @@ void* create_node(RTCThreadLocalAllocator alloc, unsigned int count, void*) {
 
 void set_children(void* node, void** children, unsigned int count, void*) {
   auto* n = static_cast<BuildNode*>(node);
-  for (unsigned i = 0; i < 4; ++i) n->children[i] = i < count ? static_cast<BuildNode*>(children[i]) : nullptr;
+  for (unsigned i = 0; i < 4; ++i)
+    n->children[i] = i < count ? static_cast<BuildNode*>(children[i]) : nullptr;
   n->count = int(count);
 }
 
 void set_bounds(void* node, const RTCBounds** bounds, unsigned int count, void*) {
   auto* n = static_cast<BuildNode*>(node);
-  for (unsigned i = 0; i < count && i < 4; ++i) n->bounds[i] = *bounds[i];
+  for (unsigned i = 0; i < count && i < 4; ++i)
+    n->bounds[i] = *bounds[i];
 }
 
-void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count, void*) {
+void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count,
+                  void*) {
   auto* n = static_cast<BuildNode*>(rtcThreadLocalAlloc(alloc, sizeof(BuildNode), 16));
   auto* ids = static_cast<unsigned*>(rtcThreadLocalAlloc(alloc, sizeof(unsigned) * count, 16));
-  for (size_t i = 0; i < count; ++i) ids[i] = prims[i].primID;
+  for (size_t i = 0; i < count; ++i)
+    ids[i] = prims[i].primID;
   *n = BuildNode{};
   n->leaf = true;
   n->count = int(count);
@@ -83,13 +86,15 @@ RTCBounds empty_bounds() {
 void set_lane(BvhNode& n, int lane, const RTCBounds& b, int code) {
   float* f[6] = {&n.min_x.x, &n.min_y.x, &n.min_z.x, &n.max_x.x, &n.max_y.x, &n.max_z.x};
   const float v[6] = {b.lower_x, b.lower_y, b.lower_z, b.upper_x, b.upper_y, b.upper_z};
-  for (int k = 0; k < 6; ++k) f[k][lane] = v[k];
+  for (int k = 0; k < 6; ++k)
+    f[k][lane] = v[k];
   (&n.child.x)[lane] = code;
 }
 
 BvhNode empty_node() {
   BvhNode n;
-  for (int lane = 0; lane < 4; ++lane) set_lane(n, lane, empty_bounds(), BVH_EMPTY);
+  for (int lane = 0; lane < 4; ++lane)
+    set_lane(n, lane, empty_bounds(), BVH_EMPTY);
   return n;
 }
 
@@ -114,7 +119,8 @@ struct Flattener {
   int leaf(const unsigned* ids, int count, int depth) {
     if (count <= BVH_MAX_LEAF) {
       int first = int(out.prim_index.size());
-      for (int i = 0; i < count; ++i) out.prim_index.push_back(int(ids[i]));
+      for (int i = 0; i < count; ++i)
+        out.prim_index.push_back(int(ids[i]));
       return bvh_leaf_code(first, count);
     }
     int at = int(out.nodes.size());
@@ -270,7 +276,8 @@ SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& material
     primitive_bounds(p, a, b);
     grow(a, b);
   }
-  for (const Light& l : scene.lights) grow(xyz_of(l.p), xyz_of(l.p));
+  for (const Light& l : scene.lights)
+    grow(xyz_of(l.p), xyz_of(l.p));
   grow(scene.camera.position, scene.camera.position);
   g.bounds_min = lo;
   g.bounds_max = hi;
@@ -286,8 +293,8 @@ EmbreeReference::EmbreeReference(const std::vector<Primitive>& triangles) {
   if (!device_) throw std::runtime_error("rtcNewDevice failed");
   scene_ = rtcNewScene(device_);
   RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                        3 * sizeof(float), 3 * triangles.size()));
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * triangles.size()));
   auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
       geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size()));
   for (size_t i = 0; i < triangles.size(); ++i) {

@@ -93,7 +93,8 @@ std::filesystem::path kernel_dir() {
 ClRuntime::ClRuntime(const std::string& device_name) {
   std::vector<DeviceInfo> devices = list_devices();
   if (devices.empty())
-    throw ClError("no OpenCL device found (is pocl-opencl-icd installed? run scripts/install-deps.sh)");
+    throw ClError(
+        "no OpenCL device found (is pocl-opencl-icd installed? run scripts/install-deps.sh)");
   const DeviceInfo* chosen = nullptr;
   if (!device_name.empty()) {
     std::string want = lower(device_name);
@@ -103,10 +104,12 @@ ClRuntime::ClRuntime(const std::string& device_name) {
         chosen = &d;
         break;
       }
-    if (!chosen) throw ClError(fmt::format("no OpenCL device matches '{}' (see `canopy info`)", device_name));
+    if (!chosen)
+      throw ClError(fmt::format("no OpenCL device matches '{}' (see `canopy info`)", device_name));
   } else {
     for (const auto& d : devices)
-      if ((d.type & CL_DEVICE_TYPE_CPU) && lower(d.platform_name).find("portable") != std::string::npos) {
+      if ((d.type & CL_DEVICE_TYPE_CPU) &&
+          lower(d.platform_name).find("portable") != std::string::npos) {
         chosen = &d;
         break;
       }
@@ -127,17 +130,21 @@ ClRuntime::ClRuntime(const std::string& device_name) {
   queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
 }
 
-std::string ClRuntime::device_name() const { return device_.getInfo<CL_DEVICE_NAME>(); }
+std::string ClRuntime::device_name() const {
+  return device_.getInfo<CL_DEVICE_NAME>();
+}
 
 cl::Program ClRuntime::build_program(const std::vector<std::string>& files,
                                      const std::string& options) const {
   std::filesystem::path dir = kernel_dir();
   std::string source;
-  for (const auto& f : files) source += read_text(dir / f) + "\n";
+  for (const auto& f : files)
+    source += read_text(dir / f) + "\n";
   cl::Program program(context_, source);
   // PoCL passes the option string to clang verbatim: no quotes, so escape spaces instead.
   std::string inc;
-  for (char c : dir.string()) inc += c == ' ' ? std::string("\\ ") : std::string(1, c);
+  for (char c : dir.string())
+    inc += c == ' ' ? std::string("\\ ") : std::string(1, c);
   std::string opts = fmt::format("-I {} -cl-std=CL1.2 {}", inc, options);
   try {
     program.build({device_}, opts.c_str());

@@ -110,10 +110,9 @@ int run_render(const RenderArgs& args) {
                renderer.geometry().prims.size(), rt.device_name().c_str());
   std::fprintf(stderr, "build %.3f s, compile %.3f s, render %.3f s%s\n", st.build_seconds,
                st.compile_seconds, st.render_seconds,
-               st.nonfinite_samples ? fmt::format(", {} non-finite samples dropped",
-                                                  st.nonfinite_samples)
-                                          .c_str()
-                                    : "");
+               st.nonfinite_samples
+                   ? fmt::format(", {} non-finite samples dropped", st.nonfinite_samples).c_str()
+                   : "");
   timings.total_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (args.stats) std::fprintf(stderr, "%s", stats_to_table(st, timings).c_str());
@@ -155,7 +154,8 @@ int main(int argc, char** argv) {
 
   RenderArgs rargs;
   CLI::App* render = app.add_subcommand("render", "Render a scene to EXR and PNG");
-  render->add_option("scene", rargs.scene, "Scene file (JSON, see docs/scene-format.md)")->required();
+  render->add_option("scene", rargs.scene, "Scene file (JSON, see docs/scene-format.md)")
+      ->required();
   render->add_option("--spp", rargs.spp, "Samples per pixel (overrides the scene)");
   render->add_option("--out", rargs.out, "Output EXR (default out/<scene>.exr)");
   render->add_option("--png", rargs.png, "Output PNG (default: the EXR path with .png)");

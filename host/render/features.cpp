@@ -43,12 +43,23 @@ KernelFeatures scene_features(const Scene& scene, int light_sampler) {
   f.light_sampler = light_sampler;
   for (const Light& l : scene.lights) {
     switch (l.type) {
-    case LIGHT_POINT: f.light_point = true; break;
-    case LIGHT_SPOT: f.light_spot = true; break;
-    case LIGHT_SPHERE: f.light_sphere = f.prim_sphere = true; break;
-    case LIGHT_QUAD: f.light_quad = true; break;
-    case LIGHT_TRIANGLE: f.light_triangle = true; break;
-    default: break;
+    case LIGHT_POINT:
+      f.light_point = true;
+      break;
+    case LIGHT_SPOT:
+      f.light_spot = true;
+      break;
+    case LIGHT_SPHERE:
+      f.light_sphere = f.prim_sphere = true;
+      break;
+    case LIGHT_QUAD:
+      f.light_quad = true;
+      break;
+    case LIGHT_TRIANGLE:
+      f.light_triangle = true;
+      break;
+    default:
+      break;
     }
   }
   return f;

@@ -15,7 +15,7 @@ LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const
   d.threshold = split_threshold;
   const uint32_t n = uint32_t(lights.size());
   if (d.kind == SAMPLER_EXHAUSTIVE) {
-    d.threshold = 1.0f;                 // split every cluster ...
+    d.threshold = 1.0f;                   // split every cluster ...
     d.max_cut = std::max<uint32_t>(1, n); // ... with a budget that never binds
   } else if (d.kind == SAMPLER_TREE_SPLIT) {
     d.max_cut = uint32_t(std::clamp(max_cut, 1, int(std::max<uint32_t>(1, n))));
@@ -29,7 +29,8 @@ LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const
   if (d.kind == SAMPLER_POWER) {
     std::vector<EmitterBounds> eb = emitter_bounds(lights);
     std::vector<double> w(eb.size());
-    for (size_t i = 0; i < eb.size(); ++i) w[i] = eb[i].energy;
+    for (size_t i = 0; i < eb.size(); ++i)
+      w[i] = eb[i].energy;
     AliasTable table(w);
     d.power_pmf = table.pmfs();
     d.alias_prob = table.thresholds();

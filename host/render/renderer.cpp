@@ -29,8 +29,8 @@ cl::Buffer device_buffer(const cl::Context& ctx, size_t bytes) {
 }
 
 const std::vector<std::string> kKernelFiles = {
-    "kernels/compact.cl",      "kernels/generate.cl",         "kernels/intersect_closest.cl",
-    "kernels/shade_surface.cl", "kernels/light_pick.cl",      "kernels/intersect_shadow.cl",
+    "kernels/compact.cl",       "kernels/generate.cl",   "kernels/intersect_closest.cl",
+    "kernels/shade_surface.cl", "kernels/light_pick.cl", "kernels/intersect_shadow.cl",
     "kernels/accumulate.cl"};
 
 constexpr int kScanBlock = 256;
@@ -38,7 +38,9 @@ constexpr int kCutBins = 65;
 
 } // namespace
 
-const std::vector<std::string>& wavefront_kernel_files() { return kKernelFiles; }
+const std::vector<std::string>& wavefront_kernel_files() {
+  return kKernelFiles;
+}
 
 RgbImage Film::mean() const {
   RgbImage img;
@@ -60,10 +62,11 @@ RgbImage Film::shadow_ray_heatmap(float max_rays) const {
   img.height = height;
   img.rgb.assign(size_t(width) * height * 3, 0.0f);
   std::vector<float> v(counts.size());
-  for (size_t p = 0; p < counts.size(); ++p) v[p] = counts[p].y > 0 ? counts[p].x / counts[p].y : 0;
+  for (size_t p = 0; p < counts.size(); ++p)
+    v[p] = counts[p].y > 0 ? counts[p].x / counts[p].y : 0;
   if (max_rays <= 0.0f) max_rays = std::max(1.0f, *std::max_element(v.begin(), v.end()));
   // A perceptually ordered ramp: black -> blue -> magenta -> orange -> yellow -> white.
-  const float3 ramp[] = {{0, 0, 0}, {0.1f, 0.1f, 0.6f}, {0.7f, 0.1f, 0.6f},
+  const float3 ramp[] = {{0, 0, 0},          {0.1f, 0.1f, 0.6f}, {0.7f, 0.1f, 0.6f},
                          {1.0f, 0.5f, 0.1f}, {1.0f, 0.9f, 0.2f}, {1, 1, 1}};
   for (size_t p = 0; p < v.size(); ++p) {
     float x = std::clamp(v[p] / max_rays, 0.0f, 1.0f) * 5.0f;
@@ -77,7 +80,8 @@ RgbImage Film::shadow_ray_heatmap(float max_rays) const {
 Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
     : rt_(rt), scene_(scene), options_(options) {
   auto t0 = Clock::now();
-  for (const MaterialDesc& m : scene.materials) materials_.push_back(m.gpu);
+  for (const MaterialDesc& m : scene.materials)
+    materials_.push_back(m.gpu);
   geometry_ = build_scene_geometry(scene, materials_);
   sampler_ = make_light_sampler_data(scene.lights, options.light_sampler, options.split_threshold,
                                      options.max_cut);
@@ -147,7 +151,8 @@ Film Renderer::render(const RenderSettings& settings) {
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
   // Every path's cut has at most max_cut items in any pass, so waves of
   // split_queue_items / max_cut paths bound the split queue.
-  size_t wave = std::max<size_t>(1, std::min(settings.wave_size, options_.split_queue_items / sampler_.max_cut));
+  size_t wave = std::max<size_t>(
+      1, std::min(settings.wave_size, options_.split_queue_items / sampler_.max_cut));
   const size_t W = size_t(std::min<uint64_t>(total, wave));
   const size_t split_cap = W * sampler_.max_cut;
   const int max_depth = scene_.integrator.max_depth;
@@ -210,8 +215,8 @@ Film Renderer::render(const RenderSettings& settings) {
     s.launches += 1;
   };
   auto path_args = [&](cl::Kernel& k, int i) {
-    for (cl::Buffer* b : {&ray_o, &ray_d, &throughput, &radiance, &rng, &hits, &shade_P, &shade_N,
-                          &shade_f})
+    for (cl::Buffer* b :
+         {&ray_o, &ray_d, &throughput, &radiance, &rng, &hits, &shade_P, &shade_N, &shade_f})
       k.setArg(i++, *b);
     return i;
   };
@@ -364,7 +369,8 @@ Film Renderer::render(const RenderSettings& settings) {
     k_accumulate.setArg(a++, film_counts);
     run("accumulate", k_accumulate, size_t(npix));
     q.finish();
-    for (auto& [stage, ev] : events) stats_.stages[stage].seconds += event_seconds(ev);
+    for (auto& [stage, ev] : events)
+      stats_.stages[stage].seconds += event_seconds(ev);
     events.clear();
     stats_.samples += uint64_t(count0);
     if (settings.progress) settings.progress(double(base + uint64_t(count0)) / double(total));
@@ -384,7 +390,8 @@ Film Renderer::render(const RenderSettings& settings) {
   stats_.nonfinite_samples += uint64_t(nf);
   std::vector<cl_int> hist(kCutBins);
   q.enqueueReadBuffer(histogram, CL_TRUE, 0, kCutBins * sizeof(cl_int), hist.data());
-  for (int k = 0; k < kCutBins; ++k) stats_.cut_size_histogram[size_t(k)] += uint64_t(hist[size_t(k)]);
+  for (int k = 0; k < kCutBins; ++k)
+    stats_.cut_size_histogram[size_t(k)] += uint64_t(hist[size_t(k)]);
   stats_.render_seconds += seconds_since(t_start);
   return film;
 }

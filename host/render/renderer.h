@@ -20,7 +20,6 @@
 
 namespace canopy {
 
-
 struct StageStats {
   double seconds = 0.0; // summed kernel time from profiling events
   uint64_t items = 0;   // work items processed
@@ -28,7 +27,7 @@ struct StageStats {
 };
 
 struct RenderStats {
-  double build_seconds = 0.0;   // primitives + BVH + light tree
+  double build_seconds = 0.0; // primitives + BVH + light tree
   double light_tree_seconds = 0.0;
   double upload_seconds = 0.0;  // buffers to the device
   double compile_seconds = 0.0; // OpenCL program build
@@ -63,8 +62,8 @@ struct RenderSettings {
 struct RendererOptions {
   std::string light_sampler = "tree-split"; // uniform | power | tree | tree-split | exhaustive
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD;
-  int max_cut = 64;                 // cut size cap per shading point (tree-split)
-  bool all_features = false;        // compile every kernel feature (tests)
+  int max_cut = 64;                   // cut size cap per shading point (tree-split)
+  bool all_features = false;          // compile every kernel feature (tests)
   size_t split_queue_items = 1 << 20; // split-queue capacity per wave
 };
 

@@ -6,12 +6,9 @@ namespace canopy {
 
 nlohmann::json stats_to_json(const RenderStats& s, const RunTimings& run) {
   nlohmann::json j;
-  j["wall_seconds"] = {{"total", run.total_seconds},
-                       {"load", run.load_seconds},
-                       {"build", s.build_seconds},
-                       {"light_tree_build", s.light_tree_seconds},
-                       {"upload", s.upload_seconds},
-                       {"compile", s.compile_seconds},
+  j["wall_seconds"] = {{"total", run.total_seconds}, {"load", run.load_seconds},
+                       {"build", s.build_seconds},   {"light_tree_build", s.light_tree_seconds},
+                       {"upload", s.upload_seconds}, {"compile", s.compile_seconds},
                        {"render", s.render_seconds}};
   j["samples"] = s.samples;
   j["shading_points"] = s.shading_points;
@@ -28,7 +25,8 @@ nlohmann::json stats_to_json(const RenderStats& s, const RunTimings& run) {
                     {"items_per_second", st.seconds > 0.0 ? double(st.items) / st.seconds : 0.0}};
   j["stages"] = stages;
   nlohmann::json hist = nlohmann::json::array();
-  for (uint64_t c : s.cut_size_histogram) hist.push_back(c);
+  for (uint64_t c : s.cut_size_histogram)
+    hist.push_back(c);
   j["cut_size_histogram"] = hist; // index k: shading points whose light cut had k shadow items
                                   // (last bin: that many or more)
   return j;
@@ -36,10 +34,11 @@ nlohmann::json stats_to_json(const RenderStats& s, const RunTimings& run) {
 
 std::string stats_to_table(const RenderStats& s, const RunTimings& run) {
   std::string out;
-  out += fmt::format("time: total {:.3f} s = load {:.3f} + build {:.3f} (light tree {:.3f}) + upload "
-                     "{:.3f} + compile {:.3f} + render {:.3f}\n",
-                     run.total_seconds, run.load_seconds, s.build_seconds, s.light_tree_seconds,
-                     s.upload_seconds, s.compile_seconds, s.render_seconds);
+  out +=
+      fmt::format("time: total {:.3f} s = load {:.3f} + build {:.3f} (light tree {:.3f}) + upload "
+                  "{:.3f} + compile {:.3f} + render {:.3f}\n",
+                  run.total_seconds, run.load_seconds, s.build_seconds, s.light_tree_seconds,
+                  s.upload_seconds, s.compile_seconds, s.render_seconds);
   out += fmt::format("{:<20} {:>10} {:>14} {:>10} {:>14}\n", "stage", "seconds", "items",
                      "launches", "items/s");
   for (const auto& [name, st] : s.stages)

@@ -34,8 +34,8 @@ struct FilmSettings {
 };
 
 struct IntegratorSettings {
-  int spp = 16;                          // samples per pixel, >= 1
-  int max_depth = 1;                     // path vertices after the camera hit: 1 = direct light only
+  int spp = 16;      // samples per pixel, >= 1
+  int max_depth = 1; // path vertices after the camera hit: 1 = direct light only
   std::string light_sampler = "uniform"; // uniform | power | tree | tree-split | exhaustive
   float split_threshold = 0.85f;         // adaptive splitting threshold in [0, 1]
   uint32_t seed = 1;

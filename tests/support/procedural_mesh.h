@@ -23,7 +23,8 @@ inline std::vector<Primitive> make_mesh(int nu = 96, int nv = 48, int random_tri
     prims.push_back(p);
   };
   auto torus = [nu, nv](int i, int j) {
-    float u = 2.0f * float(M_PI) * float(i) / float(nu), v = 2.0f * float(M_PI) * float(j) / float(nv);
+    float u = 2.0f * float(M_PI) * float(i) / float(nu),
+          v = 2.0f * float(M_PI) * float(j) / float(nv);
     float r = 0.4f * (1.0f + 0.15f * std::sin(5.0f * u) * std::cos(3.0f * v));
     return make_float3((1.0f + r * std::cos(v)) * std::cos(u), r * std::sin(v),
                        (1.0f + r * std::cos(v)) * std::sin(u));
@@ -38,7 +39,8 @@ inline std::vector<Primitive> make_mesh(int nu = 96, int nv = 48, int random_tri
   std::uniform_real_distribution<float> pos(-2.0f, 2.0f), off(-0.2f, 0.2f);
   for (int k = 0; k < random_tris; ++k) {
     float3 a = make_float3(pos(rng), pos(rng), pos(rng));
-    tri(a, a + make_float3(off(rng), off(rng), off(rng)), a + make_float3(off(rng), off(rng), off(rng)));
+    tri(a, a + make_float3(off(rng), off(rng), off(rng)),
+        a + make_float3(off(rng), off(rng), off(rng)));
   }
   return prims;
 }
