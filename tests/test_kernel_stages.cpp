@@ -13,6 +13,7 @@
 #include "integrator/light_pick.h"
 #include "integrator/shade_surface.h"
 #include "render/camera.h"
+#include "render/device_scene.h"
 #include "render/features.h"
 #include "render/light_sampler_data.h"
 #include "render/renderer.h"
@@ -58,10 +59,7 @@ const char* kSceneJson = R"({
 constexpr int kPaths = 4096;
 
 template <class T> cl::Buffer to_device(ClRuntime& rt, const std::vector<T>& v) {
-  size_t bytes = std::max<size_t>(1, v.size()) * sizeof(T);
-  if (v.empty()) return cl::Buffer(rt.context(), CL_MEM_READ_WRITE, bytes);
-  return cl::Buffer(rt.context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes,
-                    const_cast<T*>(v.data()));
+  return upload_buffer(rt.context(), v, CL_MEM_READ_WRITE);
 }
 template <class T> std::vector<T> from_device(ClRuntime& rt, const cl::Buffer& b, size_t n) {
   std::vector<T> v(n);
@@ -160,43 +158,8 @@ protected:
       k.setArg(i++, *b);
     return i;
   }
-  int set_scene_args(cl::Kernel& k, int i) {
-    k.setArg(i++, buf_nodes_);
-    k.setArg(i++, buf_prim_index_);
-    k.setArg(i++, buf_prims_);
-    k.setArg(i++, buf_materials_);
-    k.setArg(i++, cl_float(geometry_.ray_eps));
-    return i;
-  }
-  int set_sampler_args(cl::Kernel& k, int i) {
-    k.setArg(i++, cl_int(scene_.lights.size()));
-    k.setArg(i++, buf_lights_);
-    k.setArg(i++, buf_power_pmf_);
-    k.setArg(i++, buf_alias_prob_);
-    k.setArg(i++, buf_alias_index_);
-    k.setArg(i++, buf_lt_nodes_);
-    k.setArg(i++, buf_lt_children_);
-    k.setArg(i++, buf_lt_leaf_);
-    k.setArg(i++, buf_lt_trails_);
-    k.setArg(i++, sampler_.tree.root_sphere);
-    k.setArg(i++, sampler_.tree.root_info);
-    k.setArg(i++, cl_float(sampler_.threshold));
-    k.setArg(i++, cl_uint(sampler_.max_cut));
-    return i;
-  }
   void upload_scene() {
-    buf_nodes_ = to_device(rt_, geometry_.bvh.nodes);
-    buf_prim_index_ = to_device(rt_, geometry_.bvh.prim_index);
-    buf_prims_ = to_device(rt_, geometry_.prims);
-    buf_materials_ = to_device(rt_, materials_);
-    buf_lights_ = to_device(rt_, scene_.lights);
-    buf_power_pmf_ = to_device(rt_, sampler_.power_pmf);
-    buf_alias_prob_ = to_device(rt_, sampler_.alias_prob);
-    buf_alias_index_ = to_device(rt_, sampler_.alias_index);
-    buf_lt_nodes_ = to_device(rt_, sampler_.tree.nodes);
-    buf_lt_children_ = to_device(rt_, sampler_.tree.children);
-    buf_lt_leaf_ = to_device(rt_, sampler_.tree.leaf_lights);
-    buf_lt_trails_ = to_device(rt_, sampler_.tree.trails);
+    dev_ = upload_device_scene(rt_.context(), geometry_, materials_, scene_.lights, sampler_);
   }
   SceneBuffers host_scene() {
     return SceneBuffers{geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
@@ -209,9 +172,7 @@ protected:
   SceneGeometry geometry_;
   LightSamplerData sampler_;
   cl::Program program_;
-  cl::Buffer buf_nodes_, buf_prim_index_, buf_prims_, buf_materials_, buf_lights_, buf_power_pmf_,
-      buf_alias_prob_, buf_alias_index_, buf_lt_nodes_, buf_lt_children_, buf_lt_leaf_,
-      buf_lt_trails_;
+  DeviceScene dev_;
 };
 
 void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& which) {
@@ -259,8 +220,8 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     k.setArg(a++, b_queue);
     k.setArg(a++, cl_int(kPaths));
     a = set_path_args(k, a, d);
-    a = set_scene_args(k, a);
-    a = set_sampler_args(k, a);
+    a = dev_.set_scene_args(k, a);
+    a = dev_.set_light_sampler_args(k, a);
     k.setArg(a++, b_counts);
     enqueue_1d(rt_.queue(), k, kPaths);
     std::vector<int2> dev_counts = from_device<int2>(rt_, b_counts, kPaths);
@@ -308,8 +269,8 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       kp.setArg(a++, b_items);
       kp.setArg(a++, cl_int(n));
       a = set_path_args(kp, a, d2);
-      a = set_scene_args(kp, a);
-      a = set_sampler_args(kp, a);
+      a = dev_.set_scene_args(kp, a);
+      a = dev_.set_light_sampler_args(kp, a);
       kp.setArg(a++, b_child);
       kp.setArg(a++, b_shadow);
       kp.setArg(a++, b_pc);

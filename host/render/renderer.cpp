@@ -17,13 +17,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// A read-only device copy of a host vector (never zero-sized: OpenCL forbids empty buffers).
-template <class T> cl::Buffer upload(const cl::Context& ctx, const std::vector<T>& v) {
-  size_t bytes = std::max<size_t>(1, v.size()) * sizeof(T);
-  if (v.empty()) return cl::Buffer(ctx, CL_MEM_READ_ONLY, bytes);
-  return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(v.data()));
-}
-
 cl::Buffer device_buffer(const cl::Context& ctx, size_t bytes) {
   return cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<size_t>(bytes, 16));
 }
@@ -90,21 +83,10 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
 
   t0 = Clock::now();
   const cl::Context& ctx = rt.context();
-  nodes_ = upload(ctx, geometry_.bvh.nodes);
-  prim_index_ = upload(ctx, geometry_.bvh.prim_index);
-  prims_ = upload(ctx, geometry_.prims);
-  materials_buf_ = upload(ctx, materials_);
-  lights_ = upload(ctx, scene.lights);
+  device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_);
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
-  camera_ = upload(ctx, cam);
-  power_pmf_ = upload(ctx, sampler_.power_pmf);
-  alias_prob_ = upload(ctx, sampler_.alias_prob);
-  alias_index_ = upload(ctx, sampler_.alias_index);
-  lt_nodes_ = upload(ctx, sampler_.tree.nodes);
-  lt_children_ = upload(ctx, sampler_.tree.children);
-  lt_leaf_lights_ = upload(ctx, sampler_.tree.leaf_lights);
-  lt_trails_ = upload(ctx, sampler_.tree.trails);
+  camera_ = upload_buffer(ctx, cam);
   stats_.upload_seconds = seconds_since(t0);
 
   t0 = Clock::now();
@@ -114,32 +96,6 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
   stats_.cut_size_histogram.assign(kCutBins, 0);
-}
-
-int Renderer::set_scene_args(cl::Kernel& k, int i) const {
-  k.setArg(i++, nodes_);
-  k.setArg(i++, prim_index_);
-  k.setArg(i++, prims_);
-  k.setArg(i++, materials_buf_);
-  k.setArg(i++, cl_float(geometry_.ray_eps));
-  return i;
-}
-
-int Renderer::set_light_sampler_args(cl::Kernel& k, int i) const {
-  k.setArg(i++, cl_int(scene_.lights.size()));
-  k.setArg(i++, lights_);
-  k.setArg(i++, power_pmf_);
-  k.setArg(i++, alias_prob_);
-  k.setArg(i++, alias_index_);
-  k.setArg(i++, lt_nodes_);
-  k.setArg(i++, lt_children_);
-  k.setArg(i++, lt_leaf_lights_);
-  k.setArg(i++, lt_trails_);
-  k.setArg(i++, sampler_.tree.root_sphere);
-  k.setArg(i++, sampler_.tree.root_info);
-  k.setArg(i++, cl_float(sampler_.threshold));
-  k.setArg(i++, cl_uint(sampler_.max_cut));
-  return i;
 }
 
 Film Renderer::render(const RenderSettings& settings) {
@@ -266,9 +222,7 @@ Film Renderer::render(const RenderSettings& settings) {
     int count = count0;
     for (int depth = 0; depth < max_depth && count > 0; ++depth) {
       a = 0;
-      k_closest.setArg(a++, nodes_);
-      k_closest.setArg(a++, prim_index_);
-      k_closest.setArg(a++, prims_);
+      a = device_.set_bvh_args(k_closest, a);
       k_closest.setArg(a++, *q_in);
       k_closest.setArg(a++, cl_int(count));
       k_closest.setArg(a++, ray_o);
@@ -282,8 +236,8 @@ Film Renderer::render(const RenderSettings& settings) {
       k_shade.setArg(a++, *q_in);
       k_shade.setArg(a++, cl_int(count));
       a = path_args(k_shade, a);
-      a = set_scene_args(k_shade, a);
-      a = set_light_sampler_args(k_shade, a);
+      a = device_.set_scene_args(k_shade, a);
+      a = device_.set_light_sampler_args(k_shade, a);
       k_shade.setArg(a++, counts_shade);
       run("shade_surface", k_shade, size_t(count));
 
@@ -311,8 +265,8 @@ Film Renderer::render(const RenderSettings& settings) {
         k_pick.setArg(a++, *s_in);
         k_pick.setArg(a++, cl_int(n));
         a = path_args(k_pick, a);
-        a = set_scene_args(k_pick, a);
-        a = set_light_sampler_args(k_pick, a);
+        a = device_.set_scene_args(k_pick, a);
+        a = device_.set_light_sampler_args(k_pick, a);
         k_pick.setArg(a++, child_stage);
         k_pick.setArg(a++, shadow_stage);
         k_pick.setArg(a++, counts);
@@ -329,9 +283,7 @@ Film Renderer::render(const RenderSettings& settings) {
         run("scatter", k_scatter_split, size_t(n));
 
         a = 0;
-        k_shadow.setArg(a++, nodes_);
-        k_shadow.setArg(a++, prim_index_);
-        k_shadow.setArg(a++, prims_);
+        a = device_.set_bvh_args(k_shadow, a);
         k_shadow.setArg(a++, shadow);
         k_shadow.setArg(a++, cl_int(n_shadow));
         run("intersect_shadow", k_shadow, size_t(n_shadow));

@@ -8,6 +8,7 @@
 #include "cl/runtime.h"
 #include "image/image_io.h"
 #include "lighttree/light_tree.h"
+#include "render/device_scene.h"
 #include "render/features.h"
 #include "render/light_sampler_data.h"
 #include "scene/scene.h"
@@ -89,12 +90,8 @@ private:
   LightSamplerData sampler_;
   RenderStats stats_;
   cl::Program program_;
-  cl::Buffer nodes_, prim_index_, prims_, materials_buf_, lights_, camera_;
-  cl::Buffer power_pmf_, alias_prob_, alias_index_, lt_nodes_, lt_children_, lt_leaf_lights_,
-      lt_trails_;
-
-  int set_scene_args(cl::Kernel& k, int index) const;
-  int set_light_sampler_args(cl::Kernel& k, int index) const;
+  DeviceScene device_;
+  cl::Buffer camera_;
 };
 
 } // namespace canopy

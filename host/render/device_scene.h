@@ -1,0 +1,44 @@
+// The scene's device buffers and the one place that binds them to kernel arguments in the order of
+// cl/kernels/params.h (SCENE_PARAMS, LIGHT_SAMPLER_PARAMS). Used by the renderer and by the kernel
+// tests, so the argument order lives in one place.
+#pragma once
+
+#include "accel/bvh.h"
+#include "render/light_sampler_data.h"
+
+#include <CL/opencl.hpp>
+
+#include <algorithm>
+#include <vector>
+
+namespace canopy {
+
+// A device copy of a host vector (never zero-sized: OpenCL forbids empty buffers).
+template <class T>
+cl::Buffer upload_buffer(const cl::Context& ctx, const std::vector<T>& v,
+                         cl_mem_flags access = CL_MEM_READ_ONLY) {
+  size_t bytes = std::max<size_t>(1, v.size()) * sizeof(T);
+  if (v.empty()) return cl::Buffer(ctx, access, bytes);
+  return cl::Buffer(ctx, access | CL_MEM_COPY_HOST_PTR, bytes, const_cast<T*>(v.data()));
+}
+
+struct DeviceScene {
+  cl::Buffer nodes, prim_index, prims, materials, lights;
+  cl::Buffer power_pmf, alias_prob, alias_index, lt_nodes, lt_children, lt_leaf_lights, lt_trails;
+  float ray_eps = 0.0f;
+  int light_count = 0;
+  float4 root_sphere{0, 0, 0, 0}, root_info{0, 0, 0, 0};
+  float split_threshold = 0.0f;
+  uint32_t max_cut = 1;
+
+  // BVH arguments of the intersect kernels (nodes, prim_index, prims).
+  int set_bvh_args(cl::Kernel& k, int index) const;
+  int set_scene_args(cl::Kernel& k, int index) const;         // SCENE_PARAMS
+  int set_light_sampler_args(cl::Kernel& k, int index) const; // LIGHT_SAMPLER_PARAMS
+};
+
+DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geometry,
+                                const std::vector<Material>& materials,
+                                const std::vector<Light>& lights, const LightSamplerData& sampler);
+
+} // namespace canopy
