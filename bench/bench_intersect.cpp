@@ -3,6 +3,7 @@
 //   canopy_bench --benchmark_filter=Intersect
 #include "accel/bvh.h"
 #include "cl/runtime.h"
+#include "support/closest_hit_kernel.h"
 #include "support/procedural_mesh.h"
 
 #include <benchmark/benchmark.h>
@@ -38,30 +39,9 @@ void Intersect_OpenCL(benchmark::State& state) {
   IntersectFixture& f = fixture();
   ClRuntime rt;
   cl::Program program = rt.build_program({"kernels/intersect_closest.cl"});
-  auto buf = [&](auto& v) {
-    using T = typename std::decay_t<decltype(v)>::value_type;
-    return cl::Buffer(rt.context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
-                      const_cast<T*>(v.data()));
-  };
-  std::vector<int> queue(f.rays.o.size());
-  for (size_t i = 0; i < queue.size(); ++i)
-    queue[i] = int(i);
-  std::vector<Hit> hits(queue.size());
-  cl::Buffer b_nodes = buf(f.bvh.nodes), b_idx = buf(f.bvh.prim_index), b_prims = buf(f.prims),
-             b_queue = buf(queue), b_o = buf(f.rays.o), b_d = buf(f.rays.d), b_hits = buf(hits);
-  cl::Kernel k(program, "intersect_closest");
-  k.setArg(0, b_nodes);
-  k.setArg(1, b_idx);
-  k.setArg(2, b_prims);
-  k.setArg(3, b_queue);
-  k.setArg(4, cl_int(queue.size()));
-  k.setArg(5, b_o);
-  k.setArg(6, b_d);
-  k.setArg(7, b_hits);
-  for (auto _ : state) {
-    enqueue_1d(rt.queue(), k, queue.size(), local);
-    rt.queue().finish();
-  }
+  testing::ClosestHitKernel kernel(rt, program, f.bvh, f.prims, f.rays);
+  for (auto _ : state)
+    kernel.run(local);
   set_rate(state, int64_t(state.iterations()) * kRayCount);
 }
 

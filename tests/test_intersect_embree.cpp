@@ -4,6 +4,7 @@
 #include "accel/bvh.h"
 #include "cl/runtime.h"
 #include "geometry.h"
+#include "support/closest_hit_kernel.h"
 #include "support/procedural_mesh.h"
 
 #include <gtest/gtest.h>
@@ -54,29 +55,9 @@ protected:
 
 std::vector<Hit> run_closest(ClRuntime& rt, cl::Program& program, const Bvh& bvh,
                              const std::vector<Primitive>& prims, const Rays& rays) {
-  auto buf = [&](auto& v) {
-    using T = typename std::decay_t<decltype(v)>::value_type;
-    return cl::Buffer(rt.context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
-                      const_cast<T*>(v.data()));
-  };
-  std::vector<int> queue(rays.o.size());
-  for (size_t i = 0; i < queue.size(); ++i)
-    queue[i] = int(i);
-  std::vector<Hit> hits(rays.o.size());
-  cl::Buffer b_nodes = buf(bvh.nodes), b_idx = buf(bvh.prim_index), b_prims = buf(prims),
-             b_queue = buf(queue), b_o = buf(rays.o), b_d = buf(rays.d), b_hits = buf(hits);
-  cl::Kernel k(program, "intersect_closest");
-  k.setArg(0, b_nodes);
-  k.setArg(1, b_idx);
-  k.setArg(2, b_prims);
-  k.setArg(3, b_queue);
-  k.setArg(4, cl_int(queue.size()));
-  k.setArg(5, b_o);
-  k.setArg(6, b_d);
-  k.setArg(7, b_hits);
-  enqueue_1d(rt.queue(), k, queue.size());
-  rt.queue().enqueueReadBuffer(b_hits, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data());
-  return hits;
+  canopy::testing::ClosestHitKernel k(rt, program, bvh, prims, rays);
+  k.run();
+  return k.hits();
 }
 
 } // namespace
