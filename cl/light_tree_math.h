@@ -239,23 +239,11 @@ typedef int4 lt_vm4;
 #define lt_vsel(a, b, m) select(a, b, m)
 #define lt_vlo16(a) convert_float4(as_uint4(a) & (uint4)(0xffffu))
 #define lt_vhi16(a) convert_float4(as_uint4(a) >> (uint4)(16u))
-#define lt_vtranspose(a, b, c, d)                                                                  \
-  do {                                                                                             \
-    float4 t0_ = (float4)(a.x, b.x, c.x, d.x), t1_ = (float4)(a.y, b.y, c.y, d.y);                 \
-    float4 t2_ = (float4)(a.z, b.z, c.z, d.z), t3_ = (float4)(a.w, b.w, c.w, d.w);                 \
-    a = t0_;                                                                                       \
-    b = t1_;                                                                                       \
-    c = t2_;                                                                                       \
-    d = t3_;                                                                                       \
-  } while (0)
 INLINE float lt_vhmax(float4 a) {
   return fmax(fmax(a.x, a.y), fmax(a.z, a.w));
 }
 INLINE float lt_vhmin(float4 a) {
   return fmin(fmin(a.x, a.y), fmin(a.z, a.w));
-}
-INLINE float lt_vsum(float4 a) {
-  return (a.x + a.y) + (a.z + a.w);
 }
 #elif defined(__SSE2__)
 typedef __m128 lt_v4;
@@ -328,6 +316,15 @@ typedef lt_mask4 lt_vm4;
 #define lt_vsel(a, b, m) lt_sel4(a, b, m)
 #define lt_vlo16(a) lt_lo16_4(a)
 #define lt_vhi16(a) lt_hi16_4(a)
+INLINE float lt_vhmax(float4 a) {
+  return lt_maxf(lt_maxf(a.x, a.y), lt_maxf(a.z, a.w));
+}
+INLINE float lt_vhmin(float4 a) {
+  return lt_minf(lt_minf(a.x, a.y), lt_minf(a.z, a.w));
+}
+#endif
+#if defined(__OPENCL_C_VERSION__) || !defined(__SSE2__)
+// float4 lanes (OpenCL C, or C++ without SSE2): the same transpose and horizontal sum.
 #define lt_vtranspose(a, b, c, d)                                                                  \
   do {                                                                                             \
     float4 t0_ = make_float4(a.x, b.x, c.x, d.x), t1_ = make_float4(a.y, b.y, c.y, d.y);           \
@@ -337,12 +334,6 @@ typedef lt_mask4 lt_vm4;
     c = t2_;                                                                                       \
     d = t3_;                                                                                       \
   } while (0)
-INLINE float lt_vhmax(float4 a) {
-  return lt_maxf(lt_maxf(a.x, a.y), lt_maxf(a.z, a.w));
-}
-INLINE float lt_vhmin(float4 a) {
-  return lt_minf(lt_minf(a.x, a.y), lt_minf(a.z, a.w));
-}
 INLINE float lt_vsum(float4 a) {
   return (a.x + a.y) + (a.z + a.w);
 }
