@@ -32,7 +32,8 @@
 // so a leaf is ranked from its records without touching the scene's Light buffer. The tree costs
 // 52-61 bytes/emitter. trails[light]: the light's bit-trail, 2 bits per 4-wide level starting with
 // the root in the two lowest bits, then 2 bits for its index inside its leaf. root_sphere /
-// root_info: bounding sphere of all emitters; (cv2, total energy, emitter record base, 0).
+// root_info: bounding sphere of all emitters; (cv2, total energy, emitter record base, importance
+// terms: LT_TERMS_FULL or LT_TERMS_DISTANCE).
 #ifndef CANOPY_LIGHT_TREE_MATH_H
 #define CANOPY_LIGHT_TREE_MATH_H
 
@@ -70,6 +71,11 @@
 #define LT_ONE_MINUS_EPS 0.99999994f   /* largest float below 1 */
 // Cone unions are padded by this angle (radians) so rounding never uncovers an input.
 #define LT_CONE_PAD 2e-6f
+// Importance terms (root_info.w). LT_TERMS_DISTANCE drops the orientation factors of Eq. 3 (the
+// emitter cone cos(theta') and the receiver cos(theta_i')) and keeps E / d^2: the ablation of the
+// paper's Fig. 15-16 ("distance" against "distance + orientation"). The tree itself is unchanged.
+#define LT_TERMS_FULL 0.0f
+#define LT_TERMS_DISTANCE 1.0f
 // Default threshold of the adaptive split (see lt_split_measure for its meaning and calibration).
 #define LT_DEFAULT_SPLIT_THRESHOLD 0.85f
 
@@ -729,6 +735,15 @@ LT_HOT void lt_oct_decode4(float4 u, float4 v, float4* ax, float4* ay, float4* a
   *az = lt_fv(z);
 }
 
+// The orientation ablation (LT_TERMS_DISTANCE): a cone of half-angle pi around any axis bounds
+// every direction (cos theta' = 1), and N = 0 drops the receiver's incidence term.
+INLINE void lt_without_orientation(const LtTree* t, lt_v4* cos_o, lt_v4* cos_e, float3* N) {
+  if (t->root_info.w == LT_TERMS_FULL) return;
+  *cos_o = lt_vs(-1.0f);
+  *cos_e = lt_vs(-1.0f);
+  *N = make_float3(0.0f, 0.0f, 0.0f);
+}
+
 // Importance of the (up to four) emitters of a leaf, from their emitter records.
 LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) {
   int count = lt_leaf_count(code);
@@ -755,6 +770,7 @@ LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) 
   lt_vm4 spot = lt_vgt(b1, lt_vs(1.5f));
   lt_v4 cos_o = lt_vsel(b1, lt_vs(1.0f), spot);
   lt_v4 cos_e = lt_vsel(zero, lt_vsub(b1, lt_vs(2.0f)), spot);
+  lt_without_orientation(t, &cos_o, &cos_e, &N);
   return lt_fv(lt_importance_v(a0, a1, a2, a3, ax, ay, az, cos_o, cos_e, b2, P, N));
 }
 
@@ -763,10 +779,12 @@ LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) 
   lt_v4 axis = lt_vld(n + LT_AXIS);
   lt_v4 ax, ay, az;
   lt_oct_decode_v(lt_vlo16(axis), lt_vhi16(axis), &ax, &ay, &az);
+  lt_v4 cos_o = lt_vld(n + LT_COS_O);
   lt_v4 cos_e = lt_vmul(lt_vlo16(lt_vld(n + LT_CE_CV2)), lt_vs(LT_U16_SCALE));
+  lt_without_orientation(t, &cos_o, &cos_e, &N);
   return lt_fv(lt_importance_v(lt_vld(n + LT_CX), lt_vld(n + LT_CY), lt_vld(n + LT_CZ),
-                               lt_vld(n + LT_R), ax, ay, az, lt_vld(n + LT_COS_O), cos_e,
-                               lt_vld(n + LT_ENERGY), P, N));
+                               lt_vld(n + LT_R), ax, ay, az, cos_o, cos_e, lt_vld(n + LT_ENERGY), P,
+                               N));
 }
 
 // Importances of the four lanes below `code` (a node or a leaf).

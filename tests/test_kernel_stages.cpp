@@ -98,7 +98,12 @@ protected:
     for (const MaterialDesc& m : scene_.materials)
       materials_.push_back(m.gpu);
     geometry_ = build_scene_geometry(scene_, materials_);
-    sampler_ = make_light_sampler_data(scene_.lights, GetParam(), 0.85f, 16);
+    // "<sampler>-noorient": the orientation ablation (importance E / d^2)
+    std::string name = GetParam();
+    const std::string suffix = "-noorient";
+    bool orientation = !name.ends_with(suffix);
+    if (!orientation) name.resize(name.size() - suffix.size());
+    sampler_ = make_light_sampler_data(scene_.lights, name, 0.85f, 16, orientation);
     program_ = rt_.build_program(wavefront_kernel_files(),
                                  KernelFeatures::all(sampler_.kind).build_options());
   }
@@ -325,7 +330,8 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Samplers, KernelStages,
-                         ::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive"),
+                         ::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive",
+                                           "tree-noorient", "tree-split-noorient"),
                          [](const auto& p) {
                            std::string s = p.param;
                            for (char& c : s)

@@ -60,13 +60,62 @@ TEST(LightTreeSampling, UnknownSamplerThrows) {
 TEST(LightTreeSampling, PmfSumsToOne) {
   std::vector<Light> lights = mixed_lights(5000, 11, 10.0f);
   std::vector<Shade> pts = shading_points(40, -2.0f, 12.0f, 1);
-  for (const char* name : {"uniform", "power", "tree"}) {
-    auto s = make_light_sampler(name, lights);
+  LightSamplerOptions no_orientation;
+  no_orientation.orientation = false;
+  for (const char* name : {"uniform", "power", "tree", "tree-noorient"}) {
+    bool ablation = std::string(name) == "tree-noorient";
+    auto s = make_light_sampler(ablation ? "tree" : name, lights,
+                                ablation ? no_orientation : LightSamplerOptions{});
     for (const Shade& x : pts) {
       // tree: 1 everywhere (a descent never dead-ends, even where nothing contributes)
       EXPECT_NEAR(pmf_sum(*s, x.P, x.N), 1.0, 1e-4) << name;
     }
   }
+}
+
+// The orientation ablation (paper Fig. 15-16): without Eq. 3's orientation terms a cluster's
+// importance is E / d^2, so for four spot lights (bounding radius 0, one light per lane or one
+// leaf) the pmf is exactly E_l / d_l^2 normalised, whatever the normal and the spots' axes; the
+// full measure gives lights that face away or lie behind the horizon probability 0.
+TEST(LightTreeSampling, OrientationAblationRanksByEnergyOverDistanceSquared) {
+  std::vector<Light> lights = {make_spot_light(make_float3(1, 2, 0), make_float3(0, -1, 0), 0.8f,
+                                               0.9f, make_float3(3, 3, 3)),
+                               make_spot_light(make_float3(-2, 1, 1), make_float3(0, 1, 0), 0.8f,
+                                               0.9f, make_float3(1, 1, 1)),
+                               make_spot_light(make_float3(0, -1, 3), make_float3(1, 0, 0), 0.5f,
+                                               0.7f, make_float3(2, 1, 1)),
+                               make_spot_light(make_float3(4, 3, -2),
+                                               make_float3(-1, -1, 0) / std::sqrt(2.0f), 0.9f,
+                                               0.95f, make_float3(5, 4, 4))};
+  LightSamplerOptions off;
+  off.orientation = false;
+  auto ablation = make_light_sampler("tree", lights, off);
+  auto full = make_light_sampler("tree", lights);
+  const LightTree& t = *ablation->tree();
+  ASSERT_EQ(t.num_nodes(), 1);
+  for (int lane = 0; lane < 4; ++lane) { // the precondition of the exact E / d^2 ratios
+    int code = i4_get(t.children[0], lane);
+    ASSERT_TRUE(code == LT_EMPTY ||
+                (lt_is_leaf(code) && (lt_leaf_count(code) == 1 || t.children[0].y == LT_EMPTY)));
+  }
+  const float3 P = make_float3(0.5f, 0, 0);
+  double w[4], sum = 0;
+  for (int l = 0; l < 4; ++l) {
+    float3 d = xyz_of(lights[l].p) - P;
+    sum += w[l] = emitter_bounds(lights[l]).energy / dot_d(d, d);
+  }
+  int differs = 0, culled = 0;
+  for (float3 N :
+       {make_float3(0, 1, 0), make_float3(0, -1, 0), make_float3(1, 0, 0), make_float3(0, 0, 0)}) {
+    for (int l = 0; l < 4; ++l) {
+      float p = ablation->pmf(P, N, l);
+      EXPECT_NEAR(p, w[l] / sum, 2e-6) << "light " << l;
+      differs += std::fabs(full->pmf(P, N, l) - p) > 1e-3f;
+      culled += full->pmf(P, N, l) == 0.0f;
+    }
+  }
+  EXPECT_GT(differs, 4); // the switch changes the ranking ...
+  EXPECT_GT(culled, 2);  // ... and the full measure culls lights the ablation keeps
 }
 
 TEST(LightTreeSampling, SampledPmfEqualsTrailPmf) {
@@ -79,8 +128,11 @@ TEST(LightTreeSampling, SampledPmfEqualsTrailPmf) {
     const char* name;
     LightSamplerOptions opt;
   };
+  LightSamplerOptions no_orientation;
+  no_orientation.orientation = false;
   for (const Cfg& cfg : {Cfg{"uniform", {}}, Cfg{"power", {}}, Cfg{"tree", {}},
-                         Cfg{"tree-split", {}}, Cfg{"tree-split", capped}}) {
+                         Cfg{"tree-split", {}}, Cfg{"tree-split", capped},
+                         Cfg{"tree", no_orientation}, Cfg{"tree-split", no_orientation}}) {
     auto s = make_light_sampler(cfg.name, lights, cfg.opt);
     std::vector<LightPick> out;
     int picks = 0;
@@ -287,6 +339,11 @@ TEST(LightTreeSampling, EstimatorsAreUnbiased) {
   cfgs.push_back({"uniform", {}});
   cfgs.push_back({"power", {}});
   cfgs.push_back({"tree", {}});
+  LightSamplerOptions no_orientation;
+  no_orientation.orientation = false;
+  cfgs.push_back({"tree", no_orientation});
+  no_orientation.split_threshold = 0.85f;
+  cfgs.push_back({"tree-split", no_orientation});
   for (float thr : {0.5f, 0.85f, 1.0f}) {
     for (int cap : {4, 64}) {
       LightSamplerOptions o;
@@ -309,7 +366,8 @@ TEST(LightTreeSampling, EstimatorsAreUnbiased) {
       estimate(*s, lights, pts[i].P, pts[i].N, name == "uniform" ? 200000 : 40000, uint32_t(17 + i),
                &mean, &se);
       EXPECT_NEAR(mean, ref, 5.0 * se + 1e-6 * ref)
-          << name << " thr " << opt.split_threshold << " cap " << opt.max_cut << " point " << i;
+          << name << " thr " << opt.split_threshold << " cap " << opt.max_cut << " orientation "
+          << opt.orientation << " point " << i;
     }
   }
 }

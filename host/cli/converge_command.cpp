@@ -20,6 +20,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace canopy {
@@ -43,11 +44,15 @@ struct ConvergeArgs {
   uint32_t reference_seed = 1000003;
 };
 
-// One sampler configuration: "tree-split:0.5" = light sampler tree-split, threshold 0.5.
+// One sampler configuration: "tree-split:0.5" = light sampler tree-split, threshold 0.5;
+// "tree-noorient" = tree without Eq. 3's orientation terms (importance E / d^2: the ablation).
 struct SamplerConfig {
   std::string label, sampler;
   float threshold = 0.0f;
+  bool orientation = true;
 };
+
+constexpr std::string_view kNoOrientSuffix = "-noorient";
 
 struct RunRecord {
   int spp = 0;
@@ -85,9 +90,16 @@ SamplerConfig parse_config(const std::string& text, float default_threshold,
   size_t colon = text.find(':');
   c.sampler = text.substr(0, colon);
   c.threshold = default_threshold;
+  if (c.sampler.size() > kNoOrientSuffix.size() && c.sampler.ends_with(kNoOrientSuffix)) {
+    c.sampler.resize(c.sampler.size() - kNoOrientSuffix.size());
+    c.orientation = false;
+    if (c.sampler.rfind("tree", 0) != 0)
+      throw SceneError(
+          fmt::format("{}: '{}': {} applies to tree samplers only", option, text, kNoOrientSuffix));
+  }
   if (std::find(kSamplerNames.begin(), kSamplerNames.end(), c.sampler) == kSamplerNames.end())
     throw SceneError(fmt::format("{}: unknown light sampler '{}' (one of uniform, power, tree, "
-                                 "tree-split, exhaustive)",
+                                 "tree-split, exhaustive; tree samplers take -noorient)",
                                  option, c.sampler));
   if (colon != std::string::npos) {
     std::string t = text.substr(colon + 1);
@@ -218,6 +230,7 @@ void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, P
   RendererOptions opt;
   opt.light_sampler = c.sampler;
   opt.split_threshold = c.threshold;
+  opt.orientation_term = c.orientation;
   Renderer r(rt, scene, opt);
   const int half_spp = std::max(1, a.reference_spp / 2);
   auto t0 = Clock::now();
@@ -247,6 +260,7 @@ void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, P
             {{"canopy:scene", a.scene},
              {"canopy:light_sampler", c.sampler},
              {"canopy:split_threshold", fmt::format("{}", c.threshold)},
+             {"canopy:orientation_term", c.orientation ? "on" : "off"},
              {"canopy:spp", std::to_string(2 * half_spp)},
              {"canopy:seed",
               fmt::format("{} (spp/2) + {} (spp/2)", a.reference_seed, a.reference_seed + 1)},
@@ -345,6 +359,7 @@ int run_converge(const ConvergeArgs& a) {
     RendererOptions opt;
     opt.light_sampler = res.config.sampler;
     opt.split_threshold = res.config.threshold;
+    opt.orientation_term = res.config.orientation;
     renderers.push_back(std::make_unique<Renderer>(rt, *scenes.back(), opt));
     Renderer& renderer = *renderers.back();
     res.build_seconds = renderer.stats().build_seconds;
@@ -488,7 +503,8 @@ CLI::App* add_converge_command(CLI::App& app, std::function<int()>& action) {
       ->required();
   cmd->add_option("--samplers", a->samplers,
                   "Comma-separated configurations: uniform, power, tree, tree-split, exhaustive; "
-                  "tree-split:T sets the split threshold T")
+                  "tree-split:T sets the split threshold T; tree-noorient and "
+                  "tree-split-noorient[:T] drop the orientation terms of the importance")
       ->capture_default_str();
   cmd->add_option("--budget", a->budget, "Render seconds per configuration (all points and seeds)")
       ->check(CLI::PositiveNumber)

@@ -37,6 +37,8 @@ struct RenderArgs {
   std::optional<int> spp;
   std::optional<uint32_t> seed;
   std::optional<std::string> light_sampler;
+  std::optional<float> split_threshold;
+  bool no_orientation = false;
   std::string out, png, device, stats_json, heatmap;
   bool stats = false;
 };
@@ -78,6 +80,7 @@ int run_render(const RenderArgs& args) {
   }
   if (args.seed) scene.integrator.seed = *args.seed;
   if (args.light_sampler) scene.integrator.light_sampler = *args.light_sampler;
+  if (args.split_threshold) scene.integrator.split_threshold = *args.split_threshold;
 
   fs::path stem = fs::path(args.scene).stem();
   fs::path exr = args.out.empty() ? fs::path("out") / (stem.string() + ".exr") : fs::path(args.out);
@@ -87,6 +90,7 @@ int run_render(const RenderArgs& args) {
   RendererOptions ropt;
   ropt.light_sampler = scene.integrator.light_sampler;
   ropt.split_threshold = scene.integrator.split_threshold;
+  ropt.orientation_term = !args.no_orientation;
   Renderer renderer(rt, scene, ropt);
   ProgressBar bar;
   RenderSettings settings;
@@ -100,6 +104,8 @@ int run_render(const RenderArgs& args) {
   write_exr(exr, img,
             {{"canopy:scene", args.scene},
              {"canopy:light_sampler", scene.integrator.light_sampler},
+             {"canopy:split_threshold", fmt::format("{}", scene.integrator.split_threshold)},
+             {"canopy:orientation_term", args.no_orientation ? "off" : "on"},
              {"canopy:spp", std::to_string(scene.integrator.spp)},
              {"canopy:seed", std::to_string(scene.integrator.seed)}});
   write_png(png, img);
@@ -162,6 +168,13 @@ int main(int argc, char** argv) {
   render->add_option("--seed", rargs.seed, "Random seed (overrides the scene)");
   render->add_option("--light-sampler", rargs.light_sampler, "Light sampler (overrides the scene)")
       ->check(CLI::IsMember(std::vector<std::string>(std::begin(kSamplers), std::end(kSamplers))));
+  render
+      ->add_option("--split-threshold", rargs.split_threshold,
+                   "tree-split threshold in [0, 1] (overrides the scene; 0 never splits)")
+      ->check(CLI::Range(0.0, 1.0));
+  render->add_flag("--no-orientation", rargs.no_orientation,
+                   "Tree samplers: rank clusters by energy / distance^2 only (ablation of the "
+                   "orientation terms, paper Fig. 15-16)");
   render->add_option("--device", rargs.device, "OpenCL device name substring (see `canopy info`)");
   render->add_flag("--stats", rargs.stats, "Print per-stage times, throughput and cut sizes");
   render->add_option("--stats-json", rargs.stats_json, "Write the statistics as JSON to FILE");

@@ -107,7 +107,9 @@ public:
 class TreeSamplerBase : public LightSampler {
 public:
   TreeSamplerBase(const std::vector<Light>& lights, const LightSamplerOptions& opt)
-      : LightSampler(lights), opt_(opt), tree_(build_light_tree(lights, opt.build)) {}
+      : LightSampler(lights), opt_(opt), tree_(build_light_tree(lights, opt.build)) {
+    tree_.set_orientation_term(opt.orientation);
+  }
   const LightTree* tree() const override { return &tree_; }
 
 protected:

@@ -40,6 +40,7 @@ struct LightSamplerOptions {
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD; // tree-split: [0, 1], 0 never splits
   int max_cut = 64; // tree-split: at most this many picks per shading point (>= 1)
   LightTreeBuildOptions build;
+  bool orientation = true; // tree samplers: false drops Eq. 3's orientation terms (ablation)
   // Testing knob: resolution at which the descent refreshes xi (LT_XI_RES_LIMIT). INFINITY
   // disables the refresh (one rescaled xi for the whole descent, which loses precision).
   float xi_refresh_limit = LT_XI_RES_LIMIT;

@@ -77,7 +77,7 @@ struct LightTree {
   std::vector<int> leaf_lights;
   std::vector<uint32_t> trails;
   float4 root_sphere{0, 0, 0, 0};
-  float4 root_info{0, 0, 0, 0}; // x: energy CV^2, y: total energy
+  float4 root_info{0, 0, 0, 0}; // energy CV^2, total energy, emitter base, importance terms
   int num_lights = 0;
   int levels = 0; // 4-wide node levels (root level = 1)
 
@@ -85,6 +85,9 @@ struct LightTree {
   double total_energy() const { return root_info.y; }
   // Bytes of the device buffers above (excluding the scene's Light buffer).
   size_t device_bytes() const;
+  // With `false`, cluster importance keeps energy and distance only (LT_TERMS_DISTANCE: the
+  // orientation ablation of the paper's Fig. 15-16); the default is the full Eq. 3.
+  void set_orientation_term(bool on) { root_info.w = on ? LT_TERMS_FULL : LT_TERMS_DISTANCE; }
   // A traversal view over these buffers and the scene's lights (which must outlive it).
   LtTree view(const Light* lights) const;
 };

@@ -9,7 +9,8 @@
 namespace canopy {
 
 LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const std::string& name,
-                                         float split_threshold, int max_cut) {
+                                         float split_threshold, int max_cut,
+                                         bool orientation_term) {
   LightSamplerData d;
   d.kind = light_sampler_from_name(name);
   d.threshold = split_threshold;
@@ -23,6 +24,7 @@ LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const
   if (d.kind >= SAMPLER_TREE) {
     auto t0 = std::chrono::steady_clock::now();
     d.tree = build_light_tree(lights);
+    d.tree.set_orientation_term(orientation_term);
     d.tree_build_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }

@@ -27,6 +27,7 @@ struct LightSamplerData {
 
 // Throws SceneError for an unknown sampler name.
 LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const std::string& name,
-                                         float split_threshold, int max_cut);
+                                         float split_threshold, int max_cut,
+                                         bool orientation_term = true);
 
 } // namespace canopy

@@ -77,7 +77,7 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
     materials_.push_back(m.gpu);
   geometry_ = build_scene_geometry(scene, materials_);
   sampler_ = make_light_sampler_data(scene.lights, options.light_sampler, options.split_threshold,
-                                     options.max_cut);
+                                     options.max_cut, options.orientation_term);
   stats_.light_tree_seconds = sampler_.tree_build_seconds;
   stats_.build_seconds = seconds_since(t0);
 
