@@ -80,7 +80,7 @@ INLINE int ray_sphere(float3 o, float3 d, float3 c, float r, float tmin, float t
 
 INLINE int ray_primitive(const GLOBAL Primitive* prim, float3 o, float3 d, float tmin, float tmax,
                          float* t, float* u, float* v) {
-  if (HAS_PRIM_SPHERE && prim->type == PRIM_SPHERE) {
+  if (IS_PRIM(prim, PRIM_SPHERE)) {
     *u = 0.0f;
     *v = 0.0f;
     return ray_sphere(o, d, xyz_of(prim->v0), prim->v0.w, tmin, tmax, t);
@@ -190,7 +190,7 @@ INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL int* prim_ind
 
 // Geometric normal of a primitive at a hit point (not normalised to face the ray).
 INLINE float3 primitive_normal(const GLOBAL Primitive* prim, float3 p) {
-  if (HAS_PRIM_SPHERE && prim->type == PRIM_SPHERE) return normalize(p - xyz_of(prim->v0));
+  if (IS_PRIM(prim, PRIM_SPHERE)) return normalize(p - xyz_of(prim->v0));
   return normalize(cross(xyz_of(prim->e1), xyz_of(prim->e2)));
 }
 

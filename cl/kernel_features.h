@@ -14,4 +14,9 @@
 #define HAS_PRIM_SPHERE 1
 #endif
 
+// `x` has type T and the kernel has feature T: folds to 0 when the feature is off. (A ternary:
+// `HAS_T && ...` inside || draws clang's -Wconstant-logical-operand in the kernel build.)
+#define IS_LIGHT(l, T) (HAS_##T ? (l)->type == T : 0)
+#define IS_PRIM(p, T) (HAS_##T ? (p)->type == T : 0)
+
 #endif // CANOPY_CL_FEATURES_H

@@ -38,20 +38,20 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
   s.pdf = 0.0f;
   s.is_delta = 0;
   float3 L = xyz_of(l->emission);
-  if ((HAS_LIGHT_POINT && l->type == LIGHT_POINT) || (HAS_LIGHT_SPOT && l->type == LIGHT_SPOT)) {
+  if (IS_LIGHT(l, LIGHT_POINT) || IS_LIGHT(l, LIGHT_SPOT)) {
     float3 to = xyz_of(l->p) - P;
     float d2 = dot(to, to);
     if (!(d2 > 0.0f)) return s;
     s.dist = sqrt(d2);
     s.wi = to / s.dist;
     float k = 1.0f / d2;
-    if (HAS_LIGHT_SPOT && l->type == LIGHT_SPOT) k *= spot_falloff(l, -dot(s.wi, xyz_of(l->e1)));
+    if (IS_LIGHT(l, LIGHT_SPOT)) k *= spot_falloff(l, -dot(s.wi, xyz_of(l->e1)));
     s.Li = L * k;
     s.pdf = 1.0f;
     s.is_delta = 1;
     return s;
   }
-  if (HAS_LIGHT_SPHERE && l->type == LIGHT_SPHERE) {
+  if (IS_LIGHT(l, LIGHT_SPHERE)) {
     // Uniform sampling of the cone of directions the sphere subtends (pbrt-v4 §6.2.4).
     float3 c = xyz_of(l->p);
     float r = l->p.w;
@@ -84,11 +84,9 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
     return s;
   }
   // Quad and triangle: uniform in area, converted to solid angle.
-  if (!((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) ||
-        (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)))
-    return s;
+  if (!(IS_LIGHT(l, LIGHT_QUAD) || IS_LIGHT(l, LIGHT_TRIANGLE))) return s;
   float3 q;
-  if (HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) {
+  if (IS_LIGHT(l, LIGHT_QUAD)) {
     q = xyz_of(l->p) + xyz_of(l->e1) * u1 + xyz_of(l->e2) * u2;
   } else {
     float su = sqrt(u1);
@@ -109,11 +107,10 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
 // Radiance leaving light l towards direction w_out (unit, pointing away from the light), for a
 // ray that hit the light's surface.
 INLINE float3 light_emitted_radiance(const GLOBAL Light* l, float3 surface_normal, float3 w_out) {
-  if (HAS_LIGHT_SPHERE && l->type == LIGHT_SPHERE) {
+  if (IS_LIGHT(l, LIGHT_SPHERE)) {
     return dot(surface_normal, w_out) > 0.0f ? xyz_of(l->emission) : make_float3(0.0f, 0.0f, 0.0f);
   }
-  if ((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) ||
-      (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)) {
+  if (IS_LIGHT(l, LIGHT_QUAD) || IS_LIGHT(l, LIGHT_TRIANGLE)) {
     return light_emits_towards(l, w_out) ? xyz_of(l->emission) : make_float3(0.0f, 0.0f, 0.0f);
   }
   return make_float3(0.0f, 0.0f, 0.0f);
@@ -122,7 +119,7 @@ INLINE float3 light_emitted_radiance(const GLOBAL Light* l, float3 surface_norma
 // Solid-angle pdf with which sample_light() would produce the direction from P to the point x on
 // light l (for MIS when a BSDF ray hits an area light). Must mirror sample_light exactly.
 INLINE float light_pdf(const GLOBAL Light* l, float3 P, float3 x) {
-  if (HAS_LIGHT_SPHERE && l->type == LIGHT_SPHERE) {
+  if (IS_LIGHT(l, LIGHT_SPHERE)) {
     float3 to = xyz_of(l->p) - P;
     float d2 = dot(to, to);
     float r = l->p.w;
@@ -131,8 +128,7 @@ INLINE float light_pdf(const GLOBAL Light* l, float3 P, float3 x) {
     float cos_max = sqrt(fmax(0.0f, 1.0f - sin2_max));
     return 1.0f / (2.0f * CANOPY_PI * (sin2_max / (1.0f + cos_max)));
   }
-  if ((HAS_LIGHT_QUAD && l->type == LIGHT_QUAD) ||
-      (HAS_LIGHT_TRIANGLE && l->type == LIGHT_TRIANGLE)) {
+  if (IS_LIGHT(l, LIGHT_QUAD) || IS_LIGHT(l, LIGHT_TRIANGLE)) {
     float3 to = x - P;
     float d2 = dot(to, to);
     if (!(d2 > 0.0f)) return 0.0f;

@@ -914,8 +914,8 @@ INLINE float lt_pmf_below(const LtTree* t, int code, float3 P, float3 N, uint tr
 // A split item is a cluster: its bounding sphere, energy CV^2, code (node or leaf) and the cut
 // budget it may still spend. The root item is (root_sphere, root_info.x, 0, max_cut). An item
 // splits when lt_item_splits() says so: it then becomes one item per contributing lane (node: the
-// children with importance > 0, budget / number of non-empty lanes; leaf: each contributing
-// emitter taken with probability 1). Otherwise it yields lt_pick_below(code) with its probability.
+// children with importance > 0, budgets from lt_child_budgets; leaf: each contributing emitter
+// taken with probability 1). Otherwise it yields lt_pick_below(code) with its probability.
 // The budget rule bounds the cut by max_cut and, being a function of the path only, lets the pmf
 // of one light be recomputed (lt_pmf_split) without knowing the rest of the cut.
 INLINE int lt_code_lanes(const LtTree* t, int code) {
@@ -941,6 +941,56 @@ INLINE float lt_lane_cv2(const LtTree* t, int node, int lane) {
                         0xffff0000u);
 }
 
+// Cut budgets of the children of `node` (lanes with importance `imp` > 0; 0 for the others) when
+// an item with `budget` splits: every contributing child keeps 1 for its own pick; the rest goes
+// to the children that will split in turn (their split measure at P is below the threshold), in
+// proportion to importance (largest remainders get the units left by rounding down; ties go to
+// the lower lane), and a leaf child gets no more than its emitter count. The budget so flows to
+// the clusters that matter (near the shading point), and splitting can isolate single lights
+// there; an even share (budget / lanes) stops every branch log4(max_cut) levels down, at clusters
+// of N / max_cut lights however near. The budgets sum to at most `budget` (lt_item_splits ensures
+// budget >= lanes) and depend on the node's lanes only, so lt_pmf_split recomputes them along one
+// trail.
+INLINE int4 lt_child_budgets(const LtTree* t, int node, float4 imp, uint budget, float3 P,
+                             float threshold) {
+  int4 ch = t->children[node];
+  float w[4], share[4], frac[4];
+  uint cap[4];
+  float wsum = 0.0f;
+  uint k = 0u;
+  for (int j = 0; j < 4; ++j) {
+    w[j] = 0.0f;
+    cap[j] = 1u;
+    if (!(f4_get(imp, j) > 0.0f)) continue;
+    k += 1u;
+    if (!lt_should_split(lt_split_measure(P, lt_lane_sphere(t, node, j), lt_lane_cv2(t, node, j)),
+                         threshold))
+      continue;
+    int c = i4_get(ch, j);
+    w[j] = f4_get(imp, j);
+    cap[j] = c < 0 ? (uint)lt_leaf_count(c) : 0xffffffffu;
+    wsum += w[j];
+  }
+  float spare = (float)(budget > k ? budget - k : 0u);
+  uint whole = 0u;
+  for (int j = 0; j < 4; ++j) {
+    float x = wsum > 0.0f ? spare * (w[j] / wsum) : 0.0f; // w_j <= wsum: x <= spare
+    share[j] = floor(x);
+    frac[j] = x - share[j];
+    whole += (uint)share[j];
+  }
+  uint left = (uint)spare > whole ? (uint)spare - whole : 0u;
+  uint b[4];
+  for (int j = 0; j < 4; ++j) {
+    uint rank = 0u; // of this lane's remainder among the lanes that share
+    for (int i = 0; i < 4; ++i)
+      rank += (uint)(w[i] > 0.0f && (frac[i] > frac[j] || (frac[i] == frac[j] && i < j)));
+    uint extra = (uint)share[j] + (uint)(w[j] > 0.0f && rank < left);
+    b[j] = f4_get(imp, j) > 0.0f ? 1u + (extra < cap[j] - 1u ? extra : cap[j] - 1u) : 0u;
+  }
+  return make_int4((int)b[0], (int)b[1], (int)b[2], (int)b[3]);
+}
+
 // pmf of `light` under splitting (DESIGN §4 "MIS with splitting"): 1 above the item where the
 // deterministic split stopped, times the lane probabilities below it along the light's bit-trail.
 INLINE float lt_pmf_split(const LtTree* t, float3 P, float3 N, int light, float threshold,
@@ -953,12 +1003,12 @@ INLINE float lt_pmf_split(const LtTree* t, float3 P, float3 N, int light, float 
   for (;;) {
     if (!lt_item_splits(t, sphere, cv2, code, budget, P, threshold))
       return lt_pmf_below(t, code, P, N, trail);
-    budget = budget / (uint)lt_code_lanes(t, code);
     int lane = (int)(trail & 3u);
     trail = trail >> 2;
     float4 imp = lt_code_importance(t, code, P, N);
     if (!(f4_get(imp, lane) > 0.0f)) return 0.0f;
     if (code < 0) return 1.0f; // split leaf: every contributing emitter is taken
+    budget = (uint)i4_get(lt_child_budgets(t, code, imp, budget, P, threshold), lane);
     sphere = lt_lane_sphere(t, code, lane);
     cv2 = lt_lane_cv2(t, code, lane);
     code = i4_get(t->children[code], lane);

@@ -23,7 +23,7 @@ WORK=out/results
 DOCS=docs/results
 mkdir -p "$WORK" "$DOCS"
 
-SAMPLERS=uniform,power,tree,tree-split:0.0,tree-split:0.25,tree-split:0.5,tree-split:0.85,tree-split:0.95
+SAMPLERS=uniform,power,tree,tree-noorient,tree-split:0.0,tree-split:0.25,tree-split:0.5,tree-split:0.85,tree-split:0.95
 SEEDS=3
 # Clamping (--clamp) biases heavy-tailed estimators (uniform sampling of the spiral, whose error
 # would then grow with spp), so only cornell-1m clamps: its 10^6 sub-pixel ceiling lights are in

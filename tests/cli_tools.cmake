@@ -18,7 +18,8 @@ if(NOT CMAKE_SCRIPT_MODE_FILE)
     COMMAND ${CMAKE_COMMAND} -DMODE=converge -DEXE=$<TARGET_FILE:canopy>
             -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/data/tiny_converge.json
             -DDIR=${CMAKE_CURRENT_BINARY_DIR}/cli_converge -P ${CMAKE_CURRENT_LIST_FILE})
-  set_tests_properties(cli_converge PROPERTIES LABELS cli TIMEOUT 600)
+  set_tests_properties(cli_converge PROPERTIES LABELS cli TIMEOUT 600
+                       ENVIRONMENT CANOPY_KERNEL_WERROR=1)
   return()
 endif()
 
@@ -78,7 +79,8 @@ if(MODE STREQUAL "compare")
   expect_contains("${err}" "${DIR}/small.exr: size 4x4 differs from ${DIR}/a.exr (8x6)")
 elseif(MODE STREQUAL "converge")
   run_canopy(0 converge "${SCENE}" --reference "${DIR}/ref.exr" --reference-spp 64
-             --reference-sampler tree-split --samplers power,tree,tree-split:0.5 --budget 2
+             --reference-sampler tree-split --samplers power,tree,tree-noorient,tree-split:0.5
+             --budget 2
              --seeds 2 --out "${DIR}/tiny")
   foreach(f tiny.csv tiny-median.csv tiny-configs.csv tiny-time.png tiny-rays.png ref.exr)
     if(NOT EXISTS "${DIR}/${f}")
@@ -88,7 +90,7 @@ elseif(MODE STREQUAL "converge")
   file(STRINGS "${DIR}/tiny.csv" rows)
   list(GET rows 0 header)
   expect_contains("${header}" "sampler,light_sampler,split_threshold,spp,seed,seconds,shadow_rays")
-  foreach(s ",power,power," ",tree,tree," ",tree-split:0.5,tree-split,0.5,")
+  foreach(s ",power,power," ",tree,tree," ",tree-noorient,tree," ",tree-split:0.5,tree-split,0.5,")
     expect_contains("${rows}" "${s}")
   endforeach()
   expect_contains("${out}" "equal-time RMSE")
@@ -98,6 +100,8 @@ elseif(MODE STREQUAL "converge")
   expect_contains("${err}" "${DIR}/ref.exr: size 32x24 differs from the render (16x12)")
   run_canopy(2 converge "${SCENE}" --reference "${DIR}/ref.exr" --samplers power,bogus)
   expect_contains("${err}" "--samplers: unknown light sampler 'bogus'")
+  run_canopy(2 converge "${SCENE}" --reference "${DIR}/ref.exr" --samplers power-noorient)
+  expect_contains("${err}" "--samplers: 'power-noorient': -noorient applies to tree samplers only")
 else()
   message(FATAL_ERROR "cli_tools.cmake: unknown MODE '${MODE}'")
 endif()

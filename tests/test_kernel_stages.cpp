@@ -347,6 +347,7 @@ protected:
     program_ = rt_.build_program(wavefront_kernel_files(),
                                  KernelFeatures::all(SAMPLER_UNIFORM).build_options());
   }
+  void check_accumulate(int npix, int wave, uint64_t base);
   ClRuntime rt_;
   cl::Program program_;
 };
@@ -397,8 +398,16 @@ TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
 }
 
 TEST_F(KernelUtilities, AccumulateSumsEachPixelsSamplesInOrderAndDropsNonFinite) {
-  const int npix = 50, wave = 173; // several samples of some pixels in one wave
-  const uint64_t base = 1234;
+  // Several samples of some pixels in one wave, then a wave smaller than the film (one work item
+  // per pixel the wave touches; the other pixels must keep their values).
+  check_accumulate(50, 173, 1234);
+  check_accumulate(50, 137, 1234);
+  check_accumulate(50, 37, 1234);
+  check_accumulate(50, 37, 30);
+}
+
+void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
+  SCOPED_TRACE(::testing::Message() << "npix " << npix << " wave " << wave << " base " << base);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(0, 10);
   std::vector<float4> radiance(wave);
@@ -408,7 +417,7 @@ TEST_F(KernelUtilities, AccumulateSumsEachPixelsSamplesInOrderAndDropsNonFinite)
     counts[size_t(i)] = make_int2(i % 5, 1);
   }
   radiance[7].y = std::numeric_limits<float>::quiet_NaN();
-  radiance[90].z = std::numeric_limits<float>::infinity();
+  radiance[size_t(wave) / 2].z = std::numeric_limits<float>::infinity();
   std::vector<float4> sum(npix, make_float4(1, 1, 1, 2)),
       sumsq(npix, make_float4(0.5f, 0.5f, 0.5f, 0));
   std::vector<float2> fc(npix, float2{0, 0});
@@ -427,7 +436,7 @@ TEST_F(KernelUtilities, AccumulateSumsEachPixelsSamplesInOrderAndDropsNonFinite)
   k.setArg(a++, b_n);
   k.setArg(a++, b_c);
   k.setArg(a++, b_fc);
-  enqueue_1d(rt_.queue(), k, npix);
+  enqueue_1d(rt_.queue(), k, size_t(std::min(npix, wave)));
   auto dsum = from_device<float4>(rt_, b_s, npix), dsq = from_device<float4>(rt_, b_q, npix);
   auto dfc = from_device<float2>(rt_, b_fc, npix);
   EXPECT_EQ(from_device<int>(rt_, b_n, 1)[0], 2);

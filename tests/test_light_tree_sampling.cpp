@@ -372,6 +372,43 @@ TEST(LightTreeSampling, EstimatorsAreUnbiased) {
   }
 }
 
+// Budgets go where splitting continues (lt_child_budgets): at a shading point next to one of 10^4
+// lights, splitting with the default threshold and cap must reach that light itself (pmf 1: it is
+// in the cut), while the cut stays within the cap. An even share of the budget would stop three
+// 4-wide levels down, at clusters of ~160 lights.
+TEST(LightTreeSampling, SplitBudgetReachesTheNearestLights) {
+  // 10^4 point lights on a jittered 100 x 100 grid in a plane (the spiral scene's situation)
+  std::vector<Light> lights;
+  LtRng jitter = lt_rng_make(21, 0);
+  for (int y = 0; y < 100; ++y)
+    for (int x = 0; x < 100; ++x)
+      lights.push_back(make_point_light(make_float3(float(x) + 0.5f * lt_rng_next(&jitter), 0.0f,
+                                                    float(y) + 0.5f * lt_rng_next(&jitter)),
+                                        make_float3(1, 1, 1)));
+  LightSamplerOptions o; // the default threshold (0.85) and cap (64)
+  auto split = make_light_sampler("tree-split", lights, o);
+  ASSERT_GE(split->tree()->levels, 6);
+  int reached = 0;
+  for (int i = 0; i < 50; ++i) {
+    int target = i * 197;
+    float3 P = xyz_of(lights[size_t(target)].p) + make_float3(0.0f, 0.1f, 0.0f);
+    float3 N = make_float3(0, -1, 0);
+    reached += split->pmf(P, N, target) == 1.0f;
+    Rng rng = make_rng(3, uint32_t(i));
+    std::vector<LightPick> out;
+    split->sample(P, N, rng, out);
+    EXPECT_LE(out.size(), 64u);
+    EXPECT_GE(out.size(), 16u); // it did split (leaves and unsplittable items strand some)
+    bool in_cut = false;
+    for (const LightPick& p : out)
+      in_cut |= p.light == target && p.prob == 1.0f;
+    EXPECT_EQ(in_cut, split->pmf(P, N, target) == 1.0f) << "light " << target;
+  }
+  // The even share reaches none of them; importance-weighted budgets reach 46 of 50 (a point whose
+  // neighbouring clusters all want to split can still run out of budget one level early).
+  EXPECT_GE(reached, 45);
+}
+
 TEST(LightTreeSampling, SplitDecisionsInvariantToSceneScale) {
   // Scale the lights by 10^-3 / 10^3 in size and 10^-6 / 10^6 in energy (tree built from the
   // scaled lights): the same shading points (scaled) get the same cuts and the same picks.

@@ -59,7 +59,7 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
     float4 imp = lt_code_importance(t, it.code, P, N);
     if (it.code >= 0) { // interior node: its contributing lanes go to the next pass
       int4 ch = t->children[it.code];
-      uint budget = it.budget / (uint)lt_code_lanes(t, it.code);
+      int4 budgets = lt_child_budgets(t, it.code, imp, it.budget, P, ls->threshold);
       for (int lane = 0; lane < 4; ++lane) {
         int code = i4_get(ch, lane);
         if (code == LT_EMPTY || !(f4_get(imp, lane) > 0.0f)) continue;
@@ -67,7 +67,7 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
         c.sphere = lt_lane_sphere(t, it.code, lane);
         c.path = path;
         c.code = code;
-        c.budget = budget;
+        c.budget = (uint)i4_get(budgets, lane);
         c.cv2 = lt_lane_cv2(t, it.code, lane);
         children[out.x++] = c;
       }

@@ -186,7 +186,6 @@ void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float thre
   while (top > 0) {
     Item it = stack[--top];
     if (lt_item_splits(&t, it.sphere, it.cv2, it.code, it.budget, P, threshold)) {
-      uint nb = it.budget / uint(lt_code_lanes(&t, it.code));
       float4 imp = lt_code_importance(&t, it.code, P, N);
       if (it.code < 0) {
         int first = lt_leaf_first(it.code);
@@ -194,10 +193,12 @@ void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float thre
           if (f4_get(imp, j) > 0.0f) out.push_back({t.leaf_lights[first + j], 1.0f});
       } else {
         int4 ch = t.children[it.code];
+        int4 budgets = lt_child_budgets(&t, it.code, imp, it.budget, P, threshold);
         for (int lane = 3; lane >= 0; --lane) {
           int c = i4_get(ch, lane);
           if (c == LT_EMPTY || !(f4_get(imp, lane) > 0.0f)) continue;
-          stack[top++] = {lt_lane_sphere(&t, it.code, lane), lt_lane_cv2(&t, it.code, lane), c, nb};
+          stack[top++] = {lt_lane_sphere(&t, it.code, lane), lt_lane_cv2(&t, it.code, lane), c,
+                          uint(i4_get(budgets, lane))};
         }
       }
     } else {

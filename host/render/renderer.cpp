@@ -319,7 +319,7 @@ Film Renderer::render(const RenderSettings& settings) {
     k_accumulate.setArg(a++, nonfinite);
     k_accumulate.setArg(a++, path_counts);
     k_accumulate.setArg(a++, film_counts);
-    run("accumulate", k_accumulate, size_t(npix));
+    run("accumulate", k_accumulate, size_t(std::min(count0, npix)));
     q.finish();
     for (auto& [stage, ev] : events)
       stats_.stages[stage].seconds += event_seconds(ev);
