@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates docs/results.md and everything in docs/results/ from scratch: builds canopy, renders
 # a reference per scene, runs `canopy converge` for every sampler configuration, renders the heat
-# maps, and writes the report (scripts/results-report.py). About 25-30 minutes on 2 cores; not run
+# maps, and writes the report (scripts/results-report.py). About 12 minutes on 2 cores; not run
 # by CI. Timings are only meaningful on an otherwise idle machine.
 #
 #   ./scripts/make-results.sh                 # everything

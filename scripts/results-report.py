@@ -193,7 +193,7 @@ def main():
     o = []
     o.append("# Results: error against render time\n")
     o.append(f"Regenerate everything on this page (text, tables, plots) with `{a.command}` "
-             f"(about 30 minutes on 2 cores). Generated {datetime.date.today().isoformat()} at "
+             f"(about 12 minutes on 2 cores). Generated {datetime.date.today().isoformat()} at "
              f"commit `{git_commit()}` on {machine()}, OpenCL on PoCL's CPU device.\n")
     o.append(
         "Method (DESIGN.md §8): `canopy converge` renders every sampler configuration at "
