@@ -76,6 +76,8 @@
 // paper's Fig. 15-16 ("distance" against "distance + orientation"). The tree itself is unchanged.
 #define LT_TERMS_FULL 0.0f
 #define LT_TERMS_DISTANCE 1.0f
+// A cut budget that never binds (the exhaustive sampler: threshold 1 splits down to every light).
+#define LT_BUDGET_UNLIMITED 0x7fffffffu
 // Default threshold of the adaptive split (see lt_split_measure for its meaning and calibration).
 #define LT_DEFAULT_SPLIT_THRESHOLD 0.85f
 
@@ -953,6 +955,11 @@ INLINE float lt_lane_cv2(const LtTree* t, int node, int lane) {
 // trail.
 INLINE int4 lt_child_budgets(const LtTree* t, int node, float4 imp, uint budget, float3 P,
                              float threshold) {
+  if (budget >= LT_BUDGET_UNLIMITED) { // the exhaustive sampler: every child keeps it
+    int u = (int)LT_BUDGET_UNLIMITED;
+    return make_int4(imp.x > 0.0f ? u : 0, imp.y > 0.0f ? u : 0, imp.z > 0.0f ? u : 0,
+                     imp.w > 0.0f ? u : 0);
+  }
   int4 ch = t->children[node];
   float w[4], share[4], frac[4];
   uint cap[4];

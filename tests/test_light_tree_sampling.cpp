@@ -409,6 +409,33 @@ TEST(LightTreeSampling, SplitBudgetReachesTheNearestLights) {
   EXPECT_GE(reached, 45);
 }
 
+// The device's exhaustive sampler is tree splitting with threshold 1 and LT_BUDGET_UNLIMITED: its
+// cut must hold every light with importance > 0, each once with probability 1, and lt_pmf_split
+// must say 1 for each (a budget of N lights, shared down the tree, binds in unbalanced subtrees).
+TEST(LightTreeSampling, UnlimitedBudgetCutHoldsEveryContributingLight) {
+  std::vector<Light> lights = mixed_lights(3000, 23, 10.0f);
+  LightTree tree = build_light_tree(lights);
+  LtTree t = tree.view(lights.data());
+  std::vector<Shade> pts = shading_points(20, -1.0f, 11.0f, 6);
+  for (const Shade& x : pts) {
+    Rng rng = make_rng(5, 0);
+    std::vector<LightPick> out;
+    sample_tree_split(t, x.P, x.N, rng, 1.0f, int(LT_BUDGET_UNLIMITED), LT_XI_RES_LIMIT, out);
+    std::vector<int> seen(lights.size(), 0);
+    for (const LightPick& p : out) {
+      ASSERT_EQ(p.prob, 1.0f);
+      ASSERT_EQ(seen[size_t(p.light)]++, 0) << "light " << p.light << " twice";
+    }
+    for (int l = 0; l < int(lights.size()); ++l) {
+      float pmf = lt_pmf_split(&t, x.P, x.N, l, 1.0f, LT_BUDGET_UNLIMITED);
+      ASSERT_EQ(pmf, seen[size_t(l)] ? 1.0f : 0.0f) << "light " << l;
+      if (clearly_contributes(lights[size_t(l)], x.P, x.N)) {
+        ASSERT_TRUE(seen[size_t(l)]) << l;
+      }
+    }
+  }
+}
+
 TEST(LightTreeSampling, SplitDecisionsInvariantToSceneScale) {
   // Scale the lights by 10^-3 / 10^3 in size and 10^-6 / 10^6 in energy (tree built from the
   // scaled lights): the same shading points (scaled) get the same cuts and the same picks.

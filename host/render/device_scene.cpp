@@ -23,7 +23,7 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
   d.root_sphere = sampler.tree.root_sphere;
   d.root_info = sampler.tree.root_info;
   d.split_threshold = sampler.threshold;
-  d.max_cut = sampler.max_cut;
+  d.max_cut = sampler.root_budget();
   return d;
 }
 

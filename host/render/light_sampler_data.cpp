@@ -17,7 +17,7 @@ LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const
   const uint32_t n = uint32_t(lights.size());
   if (d.kind == SAMPLER_EXHAUSTIVE) {
     d.threshold = 1.0f;                   // split every cluster ...
-    d.max_cut = std::max<uint32_t>(1, n); // ... with a budget that never binds
+    d.max_cut = std::max<uint32_t>(1, n); // ... so a cut holds every light (root_budget())
   } else if (d.kind == SAMPLER_TREE_SPLIT) {
     d.max_cut = uint32_t(std::clamp(max_cut, 1, int(std::max<uint32_t>(1, n))));
   }
@@ -51,7 +51,7 @@ LightSamplerCtx LightSamplerData::host_view(const std::vector<Light>& lights) co
   ls.alias_index = alias_index.data();
   ls.tree = tree.view(lights.data());
   ls.threshold = threshold;
-  ls.max_cut = max_cut;
+  ls.max_cut = root_budget();
   return ls;
 }
 

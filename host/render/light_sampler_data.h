@@ -21,6 +21,11 @@ struct LightSamplerData {
   double tree_build_seconds = 0.0;
 
   bool splits() const { return kind == SAMPLER_TREE_SPLIT || kind == SAMPLER_EXHAUSTIVE; }
+  // The root item's cut budget in the kernels: max_cut, or for the exhaustive sampler one that
+  // never binds (its cuts still hold at most max_cut = N items, which sizes the queues).
+  uint32_t root_budget() const {
+    return kind == SAMPLER_EXHAUSTIVE ? LT_BUDGET_UNLIMITED : max_cut;
+  }
   // The sampler over these host arrays and `lights` (which must outlive the view).
   LightSamplerCtx host_view(const std::vector<Light>& lights) const;
 };

@@ -250,7 +250,7 @@ Film Renderer::render(const RenderSettings& settings) {
       k_scatter_shade.setArg(a++, split_a);
       k_scatter_shade.setArg(a++, sampler_.tree.root_sphere);
       k_scatter_shade.setArg(a++, cl_float(sampler_.tree.root_info.x));
-      k_scatter_shade.setArg(a++, cl_uint(sampler_.max_cut));
+      k_scatter_shade.setArg(a++, cl_uint(sampler_.root_budget()));
       k_scatter_shade.setArg(a++, path_counts);
       run("scatter", k_scatter_shade, size_t(count));
       stats_.shading_points += uint64_t(shade_count);
