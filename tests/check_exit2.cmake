@@ -1,5 +1,6 @@
-# Runs `EXE render SCENE` and requires exit code 2 and the expected one-line message on stderr.
-#   cmake -DEXE=<canopy> -DSCENE=<file> [-DEXPECT=<message>] -P check_exit2.cmake
+# Runs `EXE render SCENE [ARGS]` and requires exit code 2 and the expected one-line message on
+# stderr (ARGS: a ;-list of extra options).
+#   cmake -DEXE=<canopy> -DSCENE=<file> [-DEXPECT=<message>] [-DARGS=<a;b>] -P check_exit2.cmake
 # Without EXPECT, the message is "<SCENE>: " followed by the text of the scene file's first line
 # "// expect: <text>" ("{dir}" in it stands for the scene file's directory).
 if(NOT DEFINED EXE OR NOT DEFINED SCENE)
@@ -19,7 +20,7 @@ if(NOT DEFINED EXPECT)
 endif()
 
 execute_process(
-  COMMAND "${EXE}" render "${SCENE}"
+  COMMAND "${EXE}" render "${SCENE}" ${ARGS}
   RESULT_VARIABLE rc
   OUTPUT_VARIABLE out
   ERROR_VARIABLE err

@@ -17,3 +17,12 @@ add_test(NAME cli_missing_scene_file
           "-DEXPECT=${missing}: cannot open file"
           -P ${CMAKE_CURRENT_SOURCE_DIR}/check_exit2.cmake)
 set_tests_properties(cli_missing_scene_file PROPERTIES LABELS cli TIMEOUT 120)
+
+# The orientation ablation applies to the tree samplers only.
+add_test(NAME cli_no_orientation_needs_a_tree
+  COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:canopy>
+          -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/../scenes/default.json
+          "-DARGS=--light-sampler;power;--no-orientation"
+          "-DEXPECT=--no-orientation: applies to the tree samplers only (tree, tree-split), not power"
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/check_exit2.cmake)
+set_tests_properties(cli_no_orientation_needs_a_tree PROPERTIES LABELS cli TIMEOUT 120)

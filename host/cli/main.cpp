@@ -81,6 +81,10 @@ int run_render(const RenderArgs& args) {
   if (args.seed) scene.integrator.seed = *args.seed;
   if (args.light_sampler) scene.integrator.light_sampler = *args.light_sampler;
   if (args.split_threshold) scene.integrator.split_threshold = *args.split_threshold;
+  if (args.no_orientation && scene.integrator.light_sampler.rfind("tree", 0) != 0)
+    throw SceneError(fmt::format(
+        "--no-orientation: applies to the tree samplers only (tree, tree-split), not {}",
+        scene.integrator.light_sampler));
 
   fs::path stem = fs::path(args.scene).stem();
   fs::path exr = args.out.empty() ? fs::path("out") / (stem.string() + ".exr") : fs::path(args.out);
