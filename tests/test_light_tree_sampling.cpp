@@ -32,6 +32,14 @@ std::vector<Shade> shading_points(int n, float lo, float hi, uint32_t seed) {
   return s;
 }
 
+// The orientation ablation (importance E / d^2), optionally with a split threshold.
+LightSamplerOptions without_orientation(float threshold = LT_DEFAULT_SPLIT_THRESHOLD) {
+  LightSamplerOptions o;
+  o.orientation = false;
+  o.split_threshold = threshold;
+  return o;
+}
+
 double pmf_sum(const LightSampler& s, float3 P, float3 N) {
   return tbb::parallel_reduce(
       tbb::blocked_range<int>(0, s.num_lights(), 1024), 0.0,
@@ -60,12 +68,10 @@ TEST(LightTreeSampling, UnknownSamplerThrows) {
 TEST(LightTreeSampling, PmfSumsToOne) {
   std::vector<Light> lights = mixed_lights(5000, 11, 10.0f);
   std::vector<Shade> pts = shading_points(40, -2.0f, 12.0f, 1);
-  LightSamplerOptions no_orientation;
-  no_orientation.orientation = false;
   for (const char* name : {"uniform", "power", "tree", "tree-noorient"}) {
     bool ablation = std::string(name) == "tree-noorient";
     auto s = make_light_sampler(ablation ? "tree" : name, lights,
-                                ablation ? no_orientation : LightSamplerOptions{});
+                                ablation ? without_orientation() : LightSamplerOptions{});
     for (const Shade& x : pts) {
       // tree: 1 everywhere (a descent never dead-ends, even where nothing contributes)
       EXPECT_NEAR(pmf_sum(*s, x.P, x.N), 1.0, 1e-4) << name;
@@ -128,11 +134,10 @@ TEST(LightTreeSampling, SampledPmfEqualsTrailPmf) {
     const char* name;
     LightSamplerOptions opt;
   };
-  LightSamplerOptions no_orientation;
-  no_orientation.orientation = false;
-  for (const Cfg& cfg : {Cfg{"uniform", {}}, Cfg{"power", {}}, Cfg{"tree", {}},
-                         Cfg{"tree-split", {}}, Cfg{"tree-split", capped},
-                         Cfg{"tree", no_orientation}, Cfg{"tree-split", no_orientation}}) {
+  for (const Cfg& cfg :
+       {Cfg{"uniform", {}}, Cfg{"power", {}}, Cfg{"tree", {}}, Cfg{"tree-split", {}},
+        Cfg{"tree-split", capped}, Cfg{"tree", without_orientation()},
+        Cfg{"tree-split", without_orientation()}}) {
     auto s = make_light_sampler(cfg.name, lights, cfg.opt);
     std::vector<LightPick> out;
     int picks = 0;
@@ -339,11 +344,8 @@ TEST(LightTreeSampling, EstimatorsAreUnbiased) {
   cfgs.push_back({"uniform", {}});
   cfgs.push_back({"power", {}});
   cfgs.push_back({"tree", {}});
-  LightSamplerOptions no_orientation;
-  no_orientation.orientation = false;
-  cfgs.push_back({"tree", no_orientation});
-  no_orientation.split_threshold = 0.85f;
-  cfgs.push_back({"tree-split", no_orientation});
+  cfgs.push_back({"tree", without_orientation()});
+  cfgs.push_back({"tree-split", without_orientation(0.85f)});
   for (float thr : {0.5f, 0.85f, 1.0f}) {
     for (int cap : {4, 64}) {
       LightSamplerOptions o;
