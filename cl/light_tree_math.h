@@ -64,11 +64,10 @@
 // Smallest importance given to a lane that can contribute, so underflow never makes it 0 (the
 // importances of the four lanes are normalised by their maximum energy and minimum distance first).
 #define LT_IMPORTANCE_FLOOR 1e-30f
-// xi starts with 24 random bits. After choosing a lane of probability p its resolution is divided
-// by p; when fewer than LT_XI_MIN_BITS remain it is replaced by a fresh number from the rng stream.
-#define LT_XI_RES0 5.9604645e-08f      /* 2^-24 */
-#define LT_XI_RES_LIMIT 1.5258789e-05f /* 2^-16: refresh below 16 bits */
-#define LT_ONE_MINUS_EPS 0.99999994f   /* largest float below 1 */
+// Uniform floats from the rng carry 24 random bits (lt_rng_next).
+#define LT_XI_RES0 5.9604645e-08f /* 2^-24 */
+// 2^32 as a float (exact): scales a probability to the units of one 32-bit random word.
+#define LT_TWO_POW_32 4294967296.0f
 // Cone unions are padded by this angle (radians) so rounding never uncovers an input.
 #define LT_CONE_PAD 2e-6f
 // Importance terms (root_info.w). LT_TERMS_DISTANCE drops the orientation factors of Eq. 3 (the
@@ -394,6 +393,74 @@ INLINE uint lt_rng_next_u32(LtRng* r) {
 // Uniform in [0, 1) with 24 random bits.
 INLINE float lt_rng_next(LtRng* r) {
   return (float)(lt_rng_next_u32(r) >> 8) * LT_XI_RES0;
+}
+
+// ---------------------------------------------------------------- exact discrete choices
+// Every discrete choice (uniform index, alias slot and test, tree lane) is made from 32-bit
+// random words with exactly the probability the pmf functions report, at any light count and any
+// dynamic range (DESIGN §9). A float u in [0, 1) has 24 bits: it cannot index more than 2^24
+// items, nor resolve a probability below 2^-24, and a rescaled u loses bits at every decision.
+
+// floor(a * b / 2^32).
+INLINE uint lt_mulhi(uint a, uint b) {
+#ifdef __OPENCL_C_VERSION__
+  return mul_hi(a, b);
+#else
+  return (uint)(((unsigned long long)a * (unsigned long long)b) >> 32);
+#endif
+}
+
+// A uniform index in [0, n), n >= 1: (u * n) >> 32 from a 32-bit word u, with Lemire's rejection
+// ("Fast Random Integer Generation in an Interval", 2019) so every index has exactly 1/n: the low
+// half of u * n below 2^32 mod n marks the words that would give some indices one extra preimage
+// (probability < n / 2^32 per draw; the modulo is only computed then).
+INLINE uint lt_rng_index(LtRng* r, uint n) {
+  uint u = lt_rng_next_u32(r);
+  uint lo = u * n;
+  if (lo < n) {
+    uint t = (0u - n) % n; // 2^32 mod n
+    while (lo < t) {
+      u = lt_rng_next_u32(r);
+      lo = u * n;
+    }
+  }
+  return lt_mulhi(u, n);
+}
+
+// One 32-bit word w of a uniform U = 0.w1 w2 w3 ... (binary) against a boundary whose scaled value
+// *x = c * 2^32 (or its remainder after the previous words, all equal to the boundary's) is in
+// [0, 2^32). Returns 1 if U >= c, 0 if U < c, 2 if w ties with floor(*x) and the boundary has a
+// nonzero fraction: then *x becomes that fraction * 2^32 for the next word. x - floor(x) of a
+// float is exact, and so is the scaling, so each word compares 32 more bits of the boundary
+// exactly: a float boundary (24 significant bits, exponent >= -149) is resolved after at most 6
+// words, and a tie happens with probability 2^-32 per word.
+INLINE int lt_word_vs(uint w, float* x) {
+  float f = floor(*x);
+  uint fi = (uint)f;
+  float rest = *x - f;
+  if (w != fi || rest == 0.0f) return w >= fi ? 1 : 0;
+  *x = rest * LT_TWO_POW_32;
+  return 2;
+}
+
+// P(result = 1) = c exactly, for any float c (denormals included; c <= 0 or NaN: never, c >= 1:
+// always). w is U's first word; further words are drawn from r only on a tie.
+INLINE int lt_u_below(uint w, float c, LtRng* r) {
+  if (!(c > 0.0f)) return 0;
+  if (c >= 1.0f) return 1;
+  float x = c * LT_TWO_POW_32;
+  int o = lt_word_vs(w, &x);
+  while (o == 2)
+    o = lt_word_vs(lt_rng_next_u32(r), &x);
+  return o == 0;
+}
+
+// Alias method (Walker 1977; table by Vose 1991): slot i in [0, n) uniformly, then i itself when
+// U < threshold[i], else alias[i]; the slot and U come from independent words.
+INLINE int lt_alias_pick(GLOBAL const float* threshold, GLOBAL const int* alias, uint n, LtRng* r) {
+  uint slot = lt_rng_index(r, n);
+  uint w = lt_rng_next_u32(r);
+  return lt_u_below(w, threshold[slot], r) ? (int)slot : alias[slot];
 }
 
 // ---------------------------------------------------------------- orientation cones (Alg. 1)
@@ -801,27 +868,52 @@ LT_HOT float lt_lane_prob(float4 imp, int k) {
   return (s > 0.0f && ik > 0.0f) ? ik / s : 0.0f;
 }
 
-// Chooses lane k with probability I_k / sum using *xi in [0,1) and rescales *xi to [0,1) for the
-// next decision. Returns -1 if no lane contributes. Lane k is chosen when c_{k-1} <= xi * sum < c_k
-// (prefix sums), so a lane of importance 0 is never chosen.
-LT_HOT int lt_choose_lane(float4 imp, float* xi) {
+// Compare-and-swap of a sorting network on (value, lane) pairs, ascending.
+#define LT_CSWAP(va, ia, vb, ib)                                                                   \
+  do {                                                                                             \
+    if (vb < va) {                                                                                 \
+      float tv_ = va;                                                                              \
+      int ti_ = ia;                                                                                \
+      va = vb;                                                                                     \
+      ia = ib;                                                                                     \
+      vb = tv_;                                                                                    \
+      ib = ti_;                                                                                    \
+    }                                                                                              \
+  } while (0)
+
+// Chooses lane k with probability I_k / sum (what lt_lane_prob reports) from fresh 32-bit words
+// of r; -1 if no lane contributes. The lanes are sorted by ascending importance (a 4-input sorting
+// network) and U in [0, 1) picks the lane whose interval [c_j, c_j+1) holds it, c_j = (sum of
+// the j smallest) / sum: summing from the small end keeps a tiny lane beside a big one, and every
+// boundary below a lane is at most 3 times that lane's own probability, so each lane's interval
+// has the lane's probability to a few float roundings (relative, ~1e-6) however small it is. The
+// comparisons of U with the boundaries are exact (lt_word_vs: one word, more only on a tie), so
+// no probability is lost to the resolution of U. A lane of importance 0 has an empty interval.
+LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
   float s = lt_sum4(imp);
   if (!(s > 0.0f) || !is_finite_f(s)) return -1;
-  float target = *xi * s;
-  float c0 = imp.x;
-  float c1 = c0 + imp.y;
-  float c2 = c1 + imp.z;
-  int k = (target >= c0) + (target >= c1) + (target >= c2);
-  while (k > 0 && !(f4_get(imp, k) > 0.0f))
-    --k; // target rounded past the last lane
-  float lo = k == 0 ? 0.0f : (k == 1 ? c0 : (k == 2 ? c1 : c2));
-  if (!(f4_get(imp, k) > 0.0f)) { // only reachable when lane 0 is empty and target < c0 = 0
-    while (k < 3 && !(f4_get(imp, k) > 0.0f))
-      ++k;
-    lo = 0.0f;
+  float v0 = imp.x, v1 = imp.y, v2 = imp.z, v3 = imp.w;
+  int i0 = 0, i1 = 1, i2 = 2, i3 = 3;
+  LT_CSWAP(v0, i0, v1, i1);
+  LT_CSWAP(v2, i2, v3, i3);
+  LT_CSWAP(v0, i0, v2, i2);
+  LT_CSWAP(v1, i1, v3, i3);
+  LT_CSWAP(v1, i1, v2, i2);
+  float t2 = v0 + v1;
+  // c_j * 2^32 (c_3 <= 3/4: the largest lane has at least a quarter)
+  float x1 = (v0 / s) * LT_TWO_POW_32;
+  float x2 = (t2 / s) * LT_TWO_POW_32;
+  float x3 = ((t2 + v2) / s) * LT_TWO_POW_32;
+  uint w = lt_rng_next_u32(r);
+  int o1 = lt_word_vs(w, &x1), o2 = lt_word_vs(w, &x2), o3 = lt_word_vs(w, &x3);
+  while (o1 == 2 || o2 == 2 || o3 == 2) { // tied boundaries compare with U's next word
+    w = lt_rng_next_u32(r);
+    if (o1 == 2) o1 = lt_word_vs(w, &x1);
+    if (o2 == 2) o2 = lt_word_vs(w, &x2);
+    if (o3 == 2) o3 = lt_word_vs(w, &x3);
   }
-  *xi = lt_clampf((target - lo) / f4_get(imp, k), 0.0f, LT_ONE_MINUS_EPS);
-  return k;
+  int pos = o1 + o2 + o3; // boundaries at or below U
+  return pos == 0 ? i0 : (pos == 1 ? i1 : (pos == 2 ? i2 : i3));
 }
 
 // Prefetches the records of the children of a node that the next step may read: node records
@@ -843,30 +935,19 @@ LT_HOT void lt_prefetch_children(const LtTree* t, int4 ch) {
   }
 }
 
-// Stochastic descent (Alg. 2) from `code` (a node index or a leaf code) to one light. `xi` is the
-// first random number, `rng` the stream xi is refreshed from once fewer than log2(1/res_limit)
-// bits of it remain (pass LT_XI_RES_LIMIT). Returns the light index, or -1 if nothing below `code`
-// contributes; *prob = product of the lane probabilities taken below `code`.
-INLINE int lt_pick_below(const LtTree* t, int code, float3 P, float3 N, float xi, LtRng* rng,
-                         float res_limit, float* prob) {
+// Stochastic descent (Alg. 2) from `code` (a node index or a leaf code) to one light, each
+// decision from fresh words of `rng` (lt_choose_lane). Returns the light index, or -1 if nothing
+// below `code` contributes; *prob = product of the lane probabilities taken below `code`.
+INLINE int lt_pick_below(const LtTree* t, int code, float3 P, float3 N, LtRng* rng, float* prob) {
   float p = 1.0f;
-  // xi's resolution is LT_XI_RES0 / q, q = product of the probabilities since the last refresh
-  float q_min = LT_XI_RES0 / res_limit;
-  float q = 1.0f;
   *prob = 0.0f;
   while (code >= 0) {
     int4 ch = t->children[code];
     lt_prefetch_children(t, ch);
     float4 imp = lt_node_importance(t, code, P, N);
-    int lane = lt_choose_lane(imp, &xi);
+    int lane = lt_choose_lane(imp, rng);
     if (lane < 0) return -1;
-    float pk = lt_lane_prob(imp, lane);
-    p = p * pk;
-    q = q * pk;
-    if (q < q_min) {
-      xi = lt_rng_next(rng);
-      q = 1.0f;
-    }
+    p = p * lt_lane_prob(imp, lane);
     code = i4_get(ch, lane);
   }
   if (code == LT_EMPTY) return -1;
@@ -879,7 +960,7 @@ INLINE int lt_pick_below(const LtTree* t, int code, float3 P, float3 N, float xi
     LT_PREFETCH((GLOBAL const float4*)L + 5);
   }
   float4 imp = lt_leaf_importance(t, code, P, N);
-  int lane = lt_choose_lane(imp, &xi);
+  int lane = lt_choose_lane(imp, rng);
   if (lane < 0) return -1;
   p = p * lt_lane_prob(imp, lane);
   *prob = p;

@@ -73,7 +73,9 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
   for (int i = 0; i < n; ++i)
     ASSERT_EQ(seen[i], 1) << "light " << i;
 
+  // the tree stores the energies normalised by one power of two (normalize_emitter_energies)
   std::vector<EmitterBounds> eb = emitter_bounds(lights);
+  ASSERT_EQ(normalize_emitter_energies(eb), t.energy_scale);
   auto lane = [&](int node, int k, int lane_idx) {
     return f4_get(t.nodes[size_t(node) * LT_NODE_F4 + k], lane_idx);
   };
@@ -147,7 +149,7 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
     float4 sp = lt_sphere_of_box(b.bmin, b.bmax);
     ASSERT_EQ(rec[0].x, sp.x);
     ASSERT_EQ(rec[0].w, sp.w);
-    ASSERT_EQ(rec[1].z, b.energy);
+    ASSERT_EQ(rec[1].z, float(b.energy));
     float q = rec[1].y;
     double rco = q > 1.5f ? 1.0 : double(q), rce = q > 1.5f ? double(q) - 2.0 : 0.0;
     ASSERT_LE(rce, std::cos(double(b.cone.theta_e)) + 1e-7) << "light " << l;

@@ -87,9 +87,8 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
 
   // One stochastic pick below the item (codes are unique within a cut: one stream each).
   LtRng rng = lt_rng_make(seed, (uint)it.code);
-  float u = lt_rng_next(&rng);
   float pmf;
-  int light = light_sampler_pick(ls, it.code, P, N, u, &rng, &pmf);
+  int light = light_sampler_pick(ls, it.code, P, N, &rng, &pmf);
   out.z = 1;
   if (light >= 0) out.y = light_pick_shadow_item(ls, sc, pb, path, light, pmf, &rng, &shadows[0]);
   return out;

@@ -30,26 +30,24 @@ INLINE SplitItem light_sampler_root(const LightSamplerCtx* ls, int path) {
   return it;
 }
 
-// Picks one light among all of them (uniform, power) or below `code` (tree) with the random
-// numbers u (and rng, for the tree's xi refresh). Returns the light or -1; *pmf its probability.
-INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, float3 N, float u,
-                              LtRng* rng, float* pmf) {
+// Picks one light among all of them (uniform, power) or below `code` (tree) with random words
+// from rng, each choice with exactly the probability it reports (cl/light_tree_math.h, "exact
+// discrete choices"). Returns the light or -1; *pmf its probability. The host samplers
+// (host/lighttree/light_sampler.cpp) run the same functions.
+INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, float3 N, LtRng* rng,
+                              float* pmf) {
   *pmf = 0.0f;
   if (ls->light_count <= 0) return -1;
   if (ls->kind == SAMPLER_UNIFORM) {
-    int l = min((int)(u * (float)ls->light_count), ls->light_count - 1);
     *pmf = 1.0f / (float)ls->light_count;
-    return l;
+    return (int)lt_rng_index(rng, (uint)ls->light_count);
   }
   if (ls->kind == SAMPLER_POWER) {
-    float x = u * (float)ls->light_count;
-    int slot = min((int)x, ls->light_count - 1);
-    float frac = x - (float)slot;
-    int l = frac < ls->alias_prob[slot] ? slot : ls->alias_index[slot];
+    int l = lt_alias_pick(ls->alias_prob, ls->alias_index, (uint)ls->light_count, rng);
     *pmf = ls->power_pmf[l];
     return *pmf > 0.0f ? l : -1;
   }
-  return lt_pick_below(&ls->tree, code, P, N, u, rng, LT_XI_RES_LIMIT, pmf);
+  return lt_pick_below(&ls->tree, code, P, N, rng, pmf);
 }
 
 // Probability that the technique produces `light` at (P, N): for MIS when a BSDF ray hits it.

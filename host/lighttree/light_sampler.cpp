@@ -45,9 +45,8 @@ AliasTable::AliasTable(const std::vector<double>& weights) {
     threshold_[i] = 1.0f; // rounding leftovers
 }
 
-int AliasTable::sample(uint32_t u_index, float u_select) const {
-  int i = static_cast<int>((uint64_t(u_index) * uint64_t(pmf_.size())) >> 32);
-  return u_select < threshold_[i] ? i : alias_[i];
+int AliasTable::sample(Rng& rng) const {
+  return lt_alias_pick(threshold_.data(), alias_.data(), uint32_t(pmf_.size()), &rng);
 }
 
 namespace {
@@ -59,7 +58,7 @@ public:
   void sample(float3, float3, Rng& rng, std::vector<LightPick>& out) const override {
     if (lights_.empty()) return;
     int n = num_lights();
-    int i = static_cast<int>((uint64_t(next_u32(rng)) * uint64_t(n)) >> 32);
+    int i = int(lt_rng_index(&rng, uint32_t(n)));
     out.push_back({i, 1.0f / float(n)});
   }
   float pmf(float3, float3, int) const override {
@@ -79,8 +78,7 @@ public:
   const char* name() const override { return "power"; }
   void sample(float3, float3, Rng& rng, std::vector<LightPick>& out) const override {
     if (lights_.empty()) return;
-    uint32_t u = next_u32(rng);
-    int i = table_.sample(u, next_float(rng));
+    int i = table_.sample(rng);
     out.push_back({i, table_.pmf(i)});
   }
   float pmf(float3, float3, int light) const override {
@@ -117,7 +115,7 @@ protected:
   void sample_uniform(Rng& rng, std::vector<LightPick>& out) const {
     if (lights_.empty()) return;
     int n = num_lights();
-    int i = static_cast<int>((uint64_t(next_u32(rng)) * uint64_t(n)) >> 32);
+    int i = int(lt_rng_index(&rng, uint32_t(n)));
     out.push_back({i, 1.0f / float(n)});
   }
   LtTree view() const { return tree_.view(lights_.data()); }
@@ -133,7 +131,7 @@ public:
   void sample(float3 P, float3 N, Rng& rng, std::vector<LightPick>& out) const override {
     if (degenerate()) return sample_uniform(rng, out);
     LtTree t = view();
-    sample_tree(t, P, N, rng, opt_.xi_refresh_limit, out);
+    sample_tree(t, P, N, rng, out);
   }
   float pmf(float3 P, float3 N, int light) const override {
     if (lights_.empty()) return 0.0f;
@@ -150,7 +148,7 @@ public:
   void sample(float3 P, float3 N, Rng& rng, std::vector<LightPick>& out) const override {
     if (degenerate()) return sample_uniform(rng, out);
     LtTree t = view();
-    sample_tree_split(t, P, N, rng, opt_.split_threshold, opt_.max_cut, opt_.xi_refresh_limit, out);
+    sample_tree_split(t, P, N, rng, opt_.split_threshold, opt_.max_cut, out);
   }
   float pmf(float3 P, float3 N, int light) const override {
     if (lights_.empty()) return 0.0f;
@@ -162,16 +160,14 @@ public:
 
 } // namespace
 
-void sample_tree(const LtTree& t, float3 P, float3 N, Rng& rng, float xi_refresh_limit,
-                 std::vector<LightPick>& out) {
+void sample_tree(const LtTree& t, float3 P, float3 N, Rng& rng, std::vector<LightPick>& out) {
   float prob;
-  float xi = lt_rng_next(&rng);
-  int l = lt_pick_below(&t, 0, P, N, xi, &rng, xi_refresh_limit, &prob);
+  int l = lt_pick_below(&t, 0, P, N, &rng, &prob);
   if (l >= 0) out.push_back({l, prob});
 }
 
 void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float threshold, int max_cut,
-                       float xi_refresh_limit, std::vector<LightPick>& out) {
+                       std::vector<LightPick>& out) {
   struct Item {
     float4 sphere;
     float cv2;
@@ -203,8 +199,7 @@ void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float thre
       }
     } else {
       float prob;
-      float xi = lt_rng_next(&rng);
-      int l = lt_pick_below(&t, it.code, P, N, xi, &rng, xi_refresh_limit, &prob);
+      int l = lt_pick_below(&t, it.code, P, N, &rng, &prob);
       if (l >= 0) out.push_back({l, prob});
     }
   }

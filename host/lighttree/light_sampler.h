@@ -41,9 +41,6 @@ struct LightSamplerOptions {
   int max_cut = 64; // tree-split: at most this many picks per shading point (>= 1)
   LightTreeBuildOptions build;
   bool orientation = true; // tree samplers: false drops Eq. 3's orientation terms (ablation)
-  // Testing knob: resolution at which the descent refreshes xi (LT_XI_RES_LIMIT). INFINITY
-  // disables the refresh (one rescaled xi for the whole descent, which loses precision).
-  float xi_refresh_limit = LT_XI_RES_LIMIT;
 };
 
 class LightSampler {
@@ -67,13 +64,14 @@ protected:
   std::vector<Light> lights_;
 };
 
-// Vose alias table over non-negative weights; all-zero (or empty) weights give a uniform table.
+// Vose alias table over non-negative weights (built in double); all-zero (or empty) weights give a
+// uniform table. Sampling runs lt_alias_pick (cl/light_tree_math.h), the device's function.
 class AliasTable {
 public:
   AliasTable() = default;
   explicit AliasTable(const std::vector<double>& weights);
   int size() const { return static_cast<int>(pmf_.size()); }
-  int sample(uint32_t u_index, float u_select) const;
+  int sample(Rng& rng) const;
   float pmf(int i) const { return pmf_[i]; }
   // The table itself, for upload to the device (slot i keeps i when u < thresholds()[i], else
   // takes aliases()[i]).
@@ -91,10 +89,9 @@ private:
 // of the device's light_pick. sample_tree: Alg. 2 from the root. sample_tree_split: Alg. 3 as a
 // depth-first walk over split items (lt_item_splits, budget max_cut), one lt_pick_below per item
 // that does not split; every pick's prob equals lt_pmf_split() for its light.
-void sample_tree(const LtTree& t, float3 P, float3 N, Rng& rng, float xi_refresh_limit,
-                 std::vector<LightPick>& out);
+void sample_tree(const LtTree& t, float3 P, float3 N, Rng& rng, std::vector<LightPick>& out);
 void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float threshold, int max_cut,
-                       float xi_refresh_limit, std::vector<LightPick>& out);
+                       std::vector<LightPick>& out);
 
 // Throws std::invalid_argument on an unknown name or an invalid option.
 std::unique_ptr<LightSampler> make_light_sampler(const std::string& name,

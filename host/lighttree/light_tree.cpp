@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cfloat>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -439,8 +440,34 @@ EmitterBounds emitter_bounds(const Light& light) {
   float to = co >= 1.0f ? 0.0f : (co <= -1.0f ? kPi : std::acos(co));
   float te = ce <= 0.0f ? kHalfPi : std::acos(ce);
   b.cone = lt_make_cone(axis, to, te);
-  b.energy = e;
+  // lt_light_bounds' energy again in double: luminance times area (sphere: pi r^2)
+  double lum = 0.2126 * double(light.emission.x) + 0.7152 * double(light.emission.y) +
+               0.0722 * double(light.emission.z);
+  double energy = lum;
+  if (light.type == LIGHT_SPHERE) {
+    energy = lum * M_PI * double(light.p.w) * double(light.p.w);
+  } else if (light.type == LIGHT_QUAD || light.type == LIGHT_TRIANGLE) {
+    double e1[3] = {light.e1.x, light.e1.y, light.e1.z},
+           e2[3] = {light.e2.x, light.e2.y, light.e2.z};
+    double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+           cz = e1[0] * e2[1] - e1[1] * e2[0];
+    double area = std::sqrt(cx * cx + cy * cy + cz * cz);
+    energy = lum * (light.type == LIGHT_QUAD ? area : 0.5 * area);
+  }
+  (void)e;
+  b.energy = (energy > 0 && std::isfinite(energy)) ? energy : 0.0;
   return b;
+}
+
+double normalize_emitter_energies(std::vector<EmitterBounds>& emitters) {
+  double emax = 0;
+  for (const EmitterBounds& b : emitters)
+    emax = std::max(emax, b.energy);
+  if (!(emax > 0)) return 1.0;
+  double scale = std::ldexp(1.0, -std::ilogb(emax)); // emax * scale in [1, 2)
+  for (EmitterBounds& b : emitters)
+    if (b.energy > 0) b.energy = std::max(b.energy * scale, double(FLT_MIN));
+  return scale;
 }
 
 std::vector<EmitterBounds> emitter_bounds(const std::vector<Light>& lights) {
@@ -484,7 +511,7 @@ BinaryLightTree build_binary_light_tree(const std::vector<EmitterBounds>& emitte
       p.bmax = e.bmax;
       p.c = (e.bmin + e.bmax) * 0.5f;
       p.cone = hcone(e.cone);
-      p.e = e.energy;
+      p.e = float(e.energy);
       p.id = i;
     }
   });
@@ -580,7 +607,7 @@ void emitter_record(const EmitterBounds& b, int light, float4* rec) {
     double t = te + pad; // theta_o = 0
     q = t >= M_PI / 2 ? 1.0f : float_down(2.0 + std::max(std::cos(t), 0.0));
   }
-  rec[1] = make_float4(uint_as_float_(oct), q, b.energy, uint_as_float_(uint32_t(light)));
+  rec[1] = make_float4(uint_as_float_(oct), q, float(b.energy), uint_as_float_(uint32_t(light)));
 }
 
 // Greedy collapse fills every node with four lanes when it can (fewer levels); pairwise collapse
@@ -736,8 +763,11 @@ LightTree collapse_light_tree(const BinaryLightTree& bt, const std::vector<Emitt
 
 LightTree build_light_tree(const std::vector<Light>& lights, const LightTreeBuildOptions& opt) {
   std::vector<EmitterBounds> eb = emitter_bounds(lights);
+  double scale = normalize_emitter_energies(eb);
   BinaryLightTree bt = build_binary_light_tree(eb, opt);
-  return collapse_light_tree(bt, eb);
+  LightTree t = collapse_light_tree(bt, eb);
+  t.energy_scale = scale;
+  return t;
 }
 
 } // namespace canopy

@@ -25,16 +25,23 @@
 namespace canopy {
 
 // Bounds of one emitter (paper Table 1 and §5.1): box, cone, energy (luminance of the maximum
-// radiant intensity). Computed with lt_light_bounds(); the emitter records of the leaves are
-// built from them.
+// radiant intensity). Computed with lt_light_bounds(), the energy in double (emission below
+// float's normal range, e.g. 1e-40, or near its maximum times an area keeps its value); the
+// emitter records of the leaves are built from them.
 struct EmitterBounds {
   float3 bmin, bmax;
   LtCone cone; // axis, theta_o, theta_e
-  float energy;
+  double energy;
   float cos_o, cos_e; // the cone as lt_light_bounds gives it (cosines, exact)
 };
 EmitterBounds emitter_bounds(const Light& light);
 std::vector<EmitterBounds> emitter_bounds(const std::vector<Light>& lights); // parallel
+// Scales every energy by one power of two so the largest is in [1, 2) (a common scale leaves every
+// pmf unchanged) and raises a positive energy that would fall below float's normal range to
+// FLT_MIN, so the float energies of the tree are never denormal, 0 or Inf for an emitter that
+// emits (emission anywhere in 1e-40 .. 1e37, whatever global scale the emission was given).
+// Returns the scale (1 if no energy is positive).
+double normalize_emitter_energies(std::vector<EmitterBounds>& emitters);
 
 struct LightTreeBuildOptions {
   int bins = 16;             // SAOH bins per axis (2..64)
@@ -79,7 +86,8 @@ struct LightTree {
   float4 root_sphere{0, 0, 0, 0};
   float4 root_info{0, 0, 0, 0}; // energy CV^2, total energy, emitter base, importance terms
   int num_lights = 0;
-  int levels = 0; // 4-wide node levels (root level = 1)
+  int levels = 0;            // 4-wide node levels (root level = 1)
+  double energy_scale = 1.0; // the tree's energies are the emitters' times this (a power of two)
 
   int num_nodes() const { return static_cast<int>(children.size()); }
   double total_energy() const { return root_info.y; }
