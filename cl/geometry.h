@@ -5,6 +5,7 @@
 
 #include "compat.h"
 #include "kernel_features.h"
+#include "shading.h"
 #include "types.h"
 
 // Each 4-wide level pushes at most 3 nodes; the host limits the depth to BVH_MAX_DEPTH.
@@ -52,6 +53,16 @@ INLINE int ray_triangle(float3 o, float3 d, float3 v0, float3 e1, float3 e2, flo
   if (v < 0.0f || u + v > 1.0f) return 0;
   float t = dot(e2, q) * inv_det;
   if (!(t > tmin && t < tmax)) return 0;
+  // A hit within the rounding error of t is the surface the ray leaves (or geometry closer than
+  // float can resolve): reject it, as pbrt-v4's triangle test does (§6.8.7). The numerator
+  // dot(e2, cross(o - v0, e1)) has absolute error at most gamma(7) times the same sum of absolute
+  // products (o - v0 rounded, the cross product, the dot product; det's relative error adds
+  // gamma(3) t), so t's error is bounded below.
+  float3 as = fabs(s), a1 = fabs(e1);
+  float3 aq =
+      make_float3(as.y * a1.z + as.z * a1.y, as.z * a1.x + as.x * a1.z, as.x * a1.y + as.y * a1.x);
+  float t_err = fp_gamma(8) * dot(fabs(e2), aq) * fabs(inv_det) + fp_gamma(4) * t;
+  if (t <= t_err) return 0;
   *t_out = t;
   *u_out = u;
   *v_out = v;
@@ -69,11 +80,15 @@ INLINE int ray_sphere(float3 o, float3 d, float3 c, float r, float tmin, float t
   if (disc < 0.0f) return 0;
   float sq = sqrt(a * disc);
   float q = b + (b >= 0.0f ? sq : -sq);
-  float t0 = q == 0.0f ? 0.0f : (dot(f, f) - r * r) / q;
+  float ff = dot(f, f);
+  float t0 = q == 0.0f ? 0.0f : (ff - r * r) / q;
   float t1 = q / a;
   float tn = fmin(t0, t1), tf = fmax(t0, t1);
-  float t = tn > tmin ? tn : tf;
-  if (!(t > tmin && t < tmax)) return 0;
+  // The near root's numerator ff - r^2 cancels for a ray leaving the surface; a root within its
+  // rounding error (f rounded, the dot product, the difference) is the surface the ray leaves.
+  float t_err = q == 0.0f ? 0.0f : fp_gamma(8) * (ff + r * r) / fabs(q);
+  float t = tn > fmax(tmin, t_err) ? tn : tf;
+  if (!(t > tmin && t < tmax) || t <= t_err) return 0;
   *t_out = t;
   return 1;
 }
@@ -186,6 +201,30 @@ INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL int* prim_ind
   hit->u = best_u;
   hit->v = best_v;
   return best;
+}
+
+// The hit point of ray o + t d on primitive prim (t, u, v from the intersection), computed so its
+// rounding error is small and bounded (pbrt-v4 §6.8.5): *p_err gets the absolute error bound per
+// component, for offset_ray_origin. A triangle's point comes from its barycentrics (v0 + u e1 +
+// v e2 lies on the triangle's plane for any u, v; only the rounding of that sum is error), not
+// from o + t d, whose error grows with t and with |o|. A sphere's point is o + t d projected back
+// onto the sphere.
+INLINE float3 primitive_hit_point(const GLOBAL Primitive* prim, float3 o, float3 d, Hit h,
+                                  float3* p_err) {
+  if (IS_PRIM(prim, PRIM_SPHERE)) {
+    float3 c = xyz_of(prim->v0);
+    float r = prim->v0.w;
+    float3 l = (o + d * h.t) - c;
+    float len = length(l);
+    if (len > 0.0f) l = l * (r / len);
+    float3 p = c + l;
+    *p_err = fabs(l) * fp_gamma(6) + fabs(p) * fp_gamma(1);
+    return p;
+  }
+  float3 v0 = xyz_of(prim->v0), e1 = xyz_of(prim->e1) * h.u, e2 = xyz_of(prim->e2) * h.v;
+  float3 p = v0 + e1 + e2;
+  *p_err = (fabs(v0) + fabs(e1) + fabs(e2)) * fp_gamma(3);
+  return p;
 }
 
 // Geometric normal of a primitive at a hit point (not normalised to face the ray).

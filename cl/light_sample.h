@@ -5,6 +5,7 @@
 
 #include "compat.h"
 #include "kernel_features.h"
+#include "shading.h"
 #include "types.h"
 
 typedef struct LightSample {
@@ -13,14 +14,25 @@ typedef struct LightSample {
   float3 Li;    // radiance arriving along wi (delta lights: intensity / dist^2)
   float pdf;    // solid-angle pdf of wi (1 for delta lights); 0 means "no contribution"
   int is_delta; // point and spot lights
+  // Where a shadow ray towards the sample ends: the light point itself for point and spot lights;
+  // for area lights the sampled point moved off the light's surface towards P by its own float
+  // error bound, so the light's own primitive cannot occlude it (cl/shading.h).
+  float3 x;
 } LightSample;
 
-// Smoothstep falloff of a spot light between the falloff start and the cone edge.
-INLINE float spot_falloff(const GLOBAL Light* l, float cos_theta) {
-  float cos_edge = l->e1.w, cos_start = l->e2.w;
-  if (cos_theta >= cos_start) return 1.0f;
-  if (cos_theta <= cos_edge) return 0.0f;
-  float x = (cos_theta - cos_edge) / (cos_start - cos_edge);
+// Smoothstep falloff of a spot light in cos(theta) between the falloff start and the cone edge
+// (1 inside the start, 0 outside the edge; a hard edge when they coincide). w_axis_dist2 is
+// |w - axis|^2 for the unit direction w from the light to the receiver: 1 - cos(theta) =
+// |w - axis|^2 / 2 without the cancellation of 1 - dot(w, axis), which leaves only a few float
+// steps across the falloff band of a narrow spot. The host stores 1 - cos of both half-angles
+// (e2.x, e2.y, computed in double as 2 sin^2(angle / 2)).
+INLINE float spot_falloff(const GLOBAL Light* l, float w_axis_dist2) {
+  float omc = 0.5f * w_axis_dist2;
+  float omc_edge = l->e2.x, omc_start = l->e2.y;
+  if (omc <= omc_start) return omc < omc_edge ? 1.0f : 0.0f;
+  if (omc >= omc_edge) return 0.0f;
+  // x = (cos(theta) - cos_edge) / (cos_start - cos_edge), in 1 - cos terms
+  float x = (omc_edge - omc) / (omc_edge - omc_start);
   return x * x * (3.0f - 2.0f * x);
 }
 
@@ -37,15 +49,20 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
   s.Li = make_float3(0.0f, 0.0f, 0.0f);
   s.pdf = 0.0f;
   s.is_delta = 0;
+  s.x = P;
   float3 L = xyz_of(l->emission);
   if (IS_LIGHT(l, LIGHT_POINT) || IS_LIGHT(l, LIGHT_SPOT)) {
-    float3 to = xyz_of(l->p) - P;
+    s.x = xyz_of(l->p);
+    float3 to = s.x - P;
     float d2 = dot(to, to);
     if (!(d2 > 0.0f)) return s;
     s.dist = sqrt(d2);
     s.wi = to / s.dist;
     float k = 1.0f / d2;
-    if (IS_LIGHT(l, LIGHT_SPOT)) k *= spot_falloff(l, -dot(s.wi, xyz_of(l->e1)));
+    if (IS_LIGHT(l, LIGHT_SPOT)) {
+      float3 w_axis = s.wi + xyz_of(l->e1); // (-wi) - axis, up to the sign
+      k *= spot_falloff(l, dot(w_axis, w_axis));
+    }
     s.Li = L * k;
     s.pdf = 1.0f;
     s.is_delta = 1;
@@ -81,17 +98,36 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
     s.dist = fmax(0.0f, dc - sqrt(fmax(0.0f, r * r - d2 * sin2_t)));
     s.Li = L;
     s.pdf = 1.0f / (2.0f * CANOPY_PI * one_minus_cos_max);
+    // The point projected back onto the sphere (its error then follows the sphere's coordinates,
+    // not |P| and the distance), moved outwards: the visible cap faces P.
+    float3 lx = (P + s.wi * s.dist) - c;
+    float llen = length(lx);
+    if (llen > 0.0f) {
+      lx = lx * (r / llen);
+      float3 x = c + lx;
+      s.x = offset_ray_origin(x, fabs(lx) * fp_gamma(6) + fabs(x) * fp_gamma(1), lx * (1.0f / r));
+    } else {
+      s.x = P + s.wi * s.dist;
+    }
     return s;
   }
   // Quad and triangle: uniform in area, converted to solid angle.
   if (!(IS_LIGHT(l, LIGHT_QUAD) || IS_LIGHT(l, LIGHT_TRIANGLE))) return s;
-  float3 q;
+  float3 q1, q2;
   if (IS_LIGHT(l, LIGHT_QUAD)) {
-    q = xyz_of(l->p) + xyz_of(l->e1) * u1 + xyz_of(l->e2) * u2;
+    q1 = xyz_of(l->e1) * u1;
+    q2 = xyz_of(l->e2) * u2;
   } else {
     float su = sqrt(u1);
-    q = xyz_of(l->p) + xyz_of(l->e1) * (1.0f - su) + xyz_of(l->e2) * (u2 * su);
+    q1 = xyz_of(l->e1) * (1.0f - su);
+    q2 = xyz_of(l->e2) * (u2 * su);
   }
+  float3 q = xyz_of(l->p) + q1 + q2;
+  // Off the light's plane towards P by q's rounding error and that of the light's geometry
+  // triangles (their vertices are p + e1 etc. rounded): gamma(3) of each term, twice.
+  float3 q_err = (fabs(xyz_of(l->p)) + fabs(xyz_of(l->e1)) + fabs(xyz_of(l->e2))) * fp_gamma(6);
+  float3 ln = xyz_of(l->n);
+  s.x = offset_ray_origin(q, q_err, dot(ln, P - q) >= 0.0f ? ln : -ln);
   float3 to = q - P;
   float d2 = dot(to, to);
   if (!(d2 > 0.0f)) return s;

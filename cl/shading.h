@@ -23,11 +23,47 @@ INLINE float3 sample_cosine_hemisphere(float3 n, float u1, float u2) {
   return normalize(t * (r * cos(phi)) + b * (r * sin(phi)) + n * z);
 }
 
-// Origin for a ray leaving a surface at p with normal n (facing the side the ray leaves to).
-// `eps` is the scene's ray offset: 1e-5 x the scene's extent, computed on the host, so the
-// offset scales with the scene and stays hundreds of ulps above the hit point's rounding error.
-INLINE float3 offset_ray_origin(float3 p, float3 n, float eps) {
-  return p + n * eps;
+// Floating-point error bounds (pbrt-v4 §6.8.1): gamma(n) = n u / (1 - n u) bounds the relative
+// error of n successive float operations, u = 2^-24 the unit roundoff.
+INLINE float fp_gamma(int n) {
+  float nu = (float)n * 5.9604645e-8f;
+  return nu / (1.0f - nu);
+}
+
+// The neighbouring floats of v (towards +inf / -inf); +-0 step to the smallest denormal.
+INLINE float next_float_up(float v) {
+  if (v == FLT_INF) return v;
+  if (v == 0.0f) v = 0.0f; // -0 -> +0
+  uint u = float_as_uint_(v);
+  return uint_as_float_(v >= 0.0f ? u + 1u : u - 1u);
+}
+INLINE float next_float_down(float v) {
+  if (v == -FLT_INF) return v;
+  if (v == 0.0f) v = -0.0f; // +0 -> -0
+  uint u = float_as_uint_(v);
+  return uint_as_float_(v > 0.0f ? u - 1u : u + 1u);
+}
+
+// Origin for a ray leaving a surface point p, computed with absolute error at most p_err per
+// component, on the side of the (unit) normal n. The offset is the projection of the error box
+// onto n, so the origin is outside the box that holds the exact surface point, and each moved
+// component is rounded one more float away so the addition itself cannot pull it back (pbrt-v4
+// §6.8.6, OffsetRayOrigin). The offset follows the float error of the point's own coordinates:
+// a floor far out along x with a small y and z keeps a tiny offset along its normal, whatever the
+// size of the scene.
+INLINE float3 offset_ray_origin(float3 p, float3 p_err, float3 n) {
+  float d = dot(fabs(n), p_err);
+  float3 off = n * d;
+  float3 po = p + off;
+  po.x = off.x > 0.0f ? next_float_up(po.x) : (off.x < 0.0f ? next_float_down(po.x) : po.x);
+  po.y = off.y > 0.0f ? next_float_up(po.y) : (off.y < 0.0f ? next_float_down(po.y) : po.y);
+  po.z = off.z > 0.0f ? next_float_up(po.z) : (off.z < 0.0f ? next_float_down(po.z) : po.z);
+  return po;
+}
+
+// Largest absolute component (the magnitude that sets a point's float spacing).
+INLINE float max_abs3(float3 v) {
+  return fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
 }
 
 #endif // CANOPY_CL_SHADING_H

@@ -8,7 +8,7 @@
 
 // ---------------------------------------------------------------- lights
 #define LIGHT_POINT 0    // isotropic point: radiant intensity I [W/sr]
-#define LIGHT_SPOT 1     // point with a cone: I [W/sr], axis, smooth falloff
+#define LIGHT_SPOT 1     // point with a cone: I [W/sr], axis, smooth (or hard) falloff
 #define LIGHT_SPHERE 2   // spherical area light: radiance L [W/(m^2 sr)], radius r
 #define LIGHT_QUAD 3     // parallelogram area light: radiance L, one- or two-sided
 #define LIGHT_TRIANGLE 4 // triangle area light: radiance L (also every emissive mesh triangle)
@@ -18,10 +18,15 @@
 #define LIGHT_FLAG_FROM_MESH 2 // triangle is part of a mesh already in the geometry
 
 typedef struct Light {
-  float4 p;  // point/spot/sphere: position (xyz), sphere radius (w). quad: corner. triangle: v0.
-  float4 e1; // quad: edge 1; triangle: v1 - v0; spot: unit axis (xyz), cos of cone half-angle (w)
-  float4 e2; // quad: edge 2; triangle: v2 - v0; spot: cos of falloff-start half-angle (w)
-  float4 n;  // quad/triangle: unit normal of the emitting face (xyz), area (w)
+  float4 p; // point/spot/sphere: position (xyz), sphere radius (w). quad: corner. triangle: v0.
+  // quad: edge 1; triangle: v1 - v0; spot: unit axis (xyz), cos of the cone half-angle rounded
+  // down (w; a bound that only ever widens the cone, for the light tree).
+  float4 e1;
+  // quad: edge 2; triangle: v2 - v0; spot: 1 - cos of the cone half-angle (x) and of the
+  // falloff-start half-angle (y), both from 2 sin^2(angle / 2) in double (the falloff works in
+  // 1 - cos, exact for narrow cones, cl/light_sample.h); cos of the falloff start (w).
+  float4 e2;
+  float4 n;        // quad/triangle: unit normal of the emitting face (xyz), area (w)
   float4 emission; // rgb: intensity (point/spot) or radiance (area lights)
   int type;
   int flags;

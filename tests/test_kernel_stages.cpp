@@ -168,7 +168,7 @@ protected:
   }
   SceneBuffers host_scene() {
     return SceneBuffers{geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
-                        geometry_.prims.data(), materials_.data(), geometry_.ray_eps};
+                        geometry_.prims.data(), materials_.data()};
   }
 
   ClRuntime rt_;

@@ -30,12 +30,16 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   if (!s.is_delta && f.w > 0.0f) w = power_heuristic(pmf * s.pdf, cos_n * CANOPY_INV_PI);
   float3 c = xyz_of(f) * s.Li * (cos_n * w / (s.pdf * pmf));
   if (!is_finite_f(c.x + c.y + c.z) || !(max3(c) > 0.0f)) return 0;
-  float3 origin = offset_ray_origin(P, N, sc->ray_eps);
-  float3 to = P + s.wi * s.dist - origin;
+  (void)sc;
+  // P is already off the surface (shade_surface). The ray ends short of the light point by the
+  // float error of that point's own coordinates and of the distance, not by a scene-wide margin;
+  // an area light's point is already off the light's surface (sample_light).
+  float3 to = s.x - P;
   float dist = length(to);
   if (!(dist > 0.0f)) return 0;
+  float tmax = dist - fp_gamma(6) * (max_abs3(s.x) + dist);
   ShadowItem item;
-  item.origin = f4_from3(origin, fmax(dist - 2.0f * sc->ray_eps, 0.0f));
+  item.origin = f4_from3(P, fmax(tmax, 0.0f));
   item.dir = f4_from3(to / dist, uint_as_float_((uint)path));
   item.contribution = f4_from3(c, 0.0f);
   *out = item;

@@ -14,7 +14,9 @@ typedef struct PathBuffers {
   GLOBAL uint* rng;          // PCG state (cl/rng.h)
   GLOBAL Hit* hits;          // closest hit of the current ray
   // The last shading point, kept for light picking in this bounce and for MIS at the next hit.
-  GLOBAL float4* shade_P; // xyz: position, w: solid-angle pdf of the BSDF direction that left it
+  // xyz: position (the ray origin of rays leaving it, offset from the surface, cl/shading.h),
+  // w: solid-angle pdf of the BSDF direction that left it
+  GLOBAL float4* shade_P;
   GLOBAL float4* shade_N; // xyz: normal facing the incoming ray, w: light-pick seed (uint bits)
   GLOBAL float4*
       shade_f; // xyz: beta * BSDF value (diffuse: albedo/pi), w: 1 if BSDF sampling
@@ -26,7 +28,6 @@ typedef struct SceneBuffers {
   GLOBAL const int* prim_index;
   GLOBAL const Primitive* prims;
   GLOBAL const Material* materials;
-  float ray_eps; // ray origin offset, see cl/shading.h
 } SceneBuffers;
 
 #endif // CANOPY_INTEGRATOR_PATH_STATE_H

@@ -22,10 +22,15 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   Hit h = pb->hits[path];
   if (h.prim < 0) return out; // escaped: no environment light
   float3 d = xyz_of(pb->ray_d[path]);
-  float3 P = xyz_of(pb->ray_o[path]) + d * h.t;
   GLOBAL const Primitive* prim = &sc->prims[h.prim];
+  float3 P_err;
+  float3 P = primitive_hit_point(prim, xyz_of(pb->ray_o[path]), d, h, &P_err);
   float3 Ng = primitive_normal(prim, P);
   float3 N = dot(Ng, d) < 0.0f ? Ng : -Ng; // facing the incoming ray
+  // Every ray that leaves this point (the bounce and the shadow rays of light_pick) leaves on N's
+  // side, so one origin serves them all: the hit point moved off the surface by its own error
+  // bound (cl/shading.h). It is also the shading point recorded for light picking and MIS.
+  P = offset_ray_origin(P, P_err, N);
   float3 beta = xyz_of(pb->throughput[path]);
 
   if (prim->light >= 0) {
@@ -69,7 +74,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   }
   if (!(max3(beta) > 0.0f) || !(pdf > 0.0f)) return out;
   pb->shade_P[path] = f4_from3(P, pdf);
-  pb->ray_o[path] = f4_from3(offset_ray_origin(P, N, sc->ray_eps), 0.0f);
+  pb->ray_o[path] = f4_from3(P, 0.0f);
   pb->ray_d[path] = f4_from3(wo, 0.0f);
   pb->throughput[path] = f4_from3(beta, 0.0f);
   out.x = 1;

@@ -30,15 +30,14 @@
 
 #define SCENE_PARAMS                                                                               \
   __global const BvhNode *bvh_nodes, __global const int *prim_index,                               \
-      __global const Primitive *prims, __global const Material *materials, float ray_eps
+      __global const Primitive *prims, __global const Material *materials
 
 #define SCENE_ASSEMBLE(sc)                                                                         \
   SceneBuffers sc;                                                                                 \
   sc.nodes = bvh_nodes;                                                                            \
   sc.prim_index = prim_index;                                                                      \
   sc.prims = prims;                                                                                \
-  sc.materials = materials;                                                                        \
-  sc.ray_eps = ray_eps
+  sc.materials = materials
 
 #define LIGHT_SAMPLER_PARAMS                                                                       \
   int light_count, __global const Light *lights, __global const float *power_pmf,                  \

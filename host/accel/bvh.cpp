@@ -281,10 +281,6 @@ SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& material
   grow(scene.camera.position, scene.camera.position);
   g.bounds_min = lo;
   g.bounds_max = hi;
-  float3 ext = hi - lo;
-  float extent = std::max({ext.x, ext.y, ext.z, std::fabs(lo.x), std::fabs(lo.y), std::fabs(lo.z),
-                           std::fabs(hi.x), std::fabs(hi.y), std::fabs(hi.z)});
-  g.ray_eps = extent > 0.0f ? 1e-5f * extent : 1e-5f;
   return g;
 }
 

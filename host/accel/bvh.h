@@ -22,7 +22,6 @@ struct SceneGeometry {
   std::vector<Primitive> prims;
   Bvh bvh;
   float3 bounds_min{0, 0, 0}, bounds_max{0, 0, 0};
-  float ray_eps = 1e-5f; // ray origin offset: 1e-5 x the scene's extent (see cl/shading.h)
 };
 
 // Primitives for every scene triangle and every sphere/quad/triangle light (a quad is two

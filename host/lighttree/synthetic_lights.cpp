@@ -37,7 +37,8 @@ Light make_spot_light(float3 p, float3 axis, float cos_outer, float cos_inner, f
   Light l = blank(LIGHT_SPOT);
   l.p = f4_from3(p, 0.0f);
   l.e1 = f4_from3(normalize(axis), cos_outer);
-  l.e2 = make_float4(0, 0, 0, cos_inner);
+  // 1 - cos of both half-angles: what the falloff reads (cl/types.h)
+  l.e2 = make_float4(float(1.0 - double(cos_outer)), float(1.0 - double(cos_inner)), 0, cos_inner);
   l.emission = f4_from3(intensity, 0.0f);
   return l;
 }

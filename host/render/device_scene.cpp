@@ -18,7 +18,6 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
   d.lt_children = upload_buffer(ctx, sampler.tree.children);
   d.lt_leaf_lights = upload_buffer(ctx, sampler.tree.leaf_lights);
   d.lt_trails = upload_buffer(ctx, sampler.tree.trails);
-  d.ray_eps = geometry.ray_eps;
   d.light_count = int(lights.size());
   d.root_sphere = sampler.tree.root_sphere;
   d.root_info = sampler.tree.root_info;
@@ -37,7 +36,6 @@ int DeviceScene::set_bvh_args(cl::Kernel& k, int i) const {
 int DeviceScene::set_scene_args(cl::Kernel& k, int i) const {
   i = set_bvh_args(k, i);
   k.setArg(i++, materials);
-  k.setArg(i++, cl_float(ray_eps));
   return i;
 }
 

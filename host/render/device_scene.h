@@ -25,7 +25,6 @@ cl::Buffer upload_buffer(const cl::Context& ctx, const std::vector<T>& v,
 struct DeviceScene {
   cl::Buffer nodes, prim_index, prims, materials, lights;
   cl::Buffer power_pmf, alias_prob, alias_index, lt_nodes, lt_children, lt_leaf_lights, lt_trails;
-  float ray_eps = 0.0f;
   int light_count = 0;
   float4 root_sphere{0, 0, 0, 0}, root_info{0, 0, 0, 0};
   float split_threshold = 0.0f;

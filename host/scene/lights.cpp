@@ -19,6 +19,21 @@ bool finish_area_light(Light& l) {
   return true;
 }
 
+void set_spot_cone(Light& l, double cone_deg, double start_deg) {
+  const double d2r = 3.14159265358979323846 / 180.0;
+  auto one_minus_cos = [&](double deg) {
+    double h = std::sin(0.5 * deg * d2r);
+    return 2.0 * h * h; // 1 - cos without cancellation
+  };
+  // cos of the edge rounded down: the light tree's cone bound never excludes a lit direction
+  double ce = std::cos(cone_deg * d2r);
+  float ce_f = float(ce);
+  if (double(ce_f) > ce) ce_f = std::nextafter(ce_f, -2.0f);
+  l.e1.w = ce_f;
+  l.e2 = make_float4(float(one_minus_cos(cone_deg)), float(one_minus_cos(start_deg)), 0.0f,
+                     float(std::cos(start_deg * d2r)));
+}
+
 namespace {
 
 float3 vec_or(const JsonObject& o, std::string_view key, bool is_template, float3 def) {
@@ -49,16 +64,16 @@ Light parse_light(const JsonValue& v, bool is_template) {
     float3 dir = normalize(o.req("direction").as_vec3_nonzero());
     if (!std::isfinite(dir.x) || !std::isfinite(dir.y) || !std::isfinite(dir.z))
       o.req("direction").fail("cannot be normalised");
+    l.e1 = f4_from3(dir, 0.0f);
     float cone = o.req("cone_angle").as_float();
     if (!(cone > 0.0f && cone <= 180.0f)) o.req("cone_angle").fail("must be in (0, 180]");
     float start = 0.8f * cone;
     if (auto fs = o.get("falloff_start")) {
       start = fs->as_float();
-      if (!(start >= 0.0f && start < cone)) fs->fail("must be in [0, cone_angle)");
+      // falloff_start == cone_angle: a hard edge (step falloff)
+      if (!(start >= 0.0f && start <= cone)) fs->fail("must be in [0, cone_angle]");
     }
-    const double d2r = 3.14159265358979323846 / 180.0;
-    l.e1 = f4_from3(dir, float(std::cos(double(cone) * d2r)));
-    l.e2 = make_float4(0, 0, 0, float(std::cos(double(start) * d2r)));
+    set_spot_cone(l, double(cone), double(start));
     l.emission = f4_from3(o.req("intensity").as_emission(), 0.0f);
   } else if (type == "sphere") {
     o.allow({"type", "center", "radius", "radiance"});

@@ -117,6 +117,8 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
 Light parse_light(const JsonValue& v, bool is_template);
 // Fills n (unit normal, area in w) of a quad/triangle light; false if the area is zero.
 bool finish_area_light(Light& l);
+// A spot's cone fields (cl/types.h) from its half-angles in degrees (start <= cone).
+void set_spot_cone(Light& l, double cone_deg, double start_deg);
 // Light sets (light_sets.cpp): expands one entry of "light_sets".
 void expand_light_set(const JsonValue& v, Builder& b);
 
