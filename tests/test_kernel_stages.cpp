@@ -418,9 +418,9 @@ void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
   }
   radiance[7].y = std::numeric_limits<float>::quiet_NaN();
   radiance[size_t(wave) / 2].z = std::numeric_limits<float>::infinity();
-  std::vector<float4> sum(npix, make_float4(1, 1, 1, 2)),
-      sumsq(npix, make_float4(0.5f, 0.5f, 0.5f, 0));
-  std::vector<float2> fc(npix, float2{0, 0});
+  std::vector<double4> sum(size_t(npix), double4{1, 1, 1, 2}),
+      sumsq(size_t(npix), double4{0.5, 0.5, 0.5, 0});
+  std::vector<double2> fc(size_t(npix), double2{0, 0});
   std::vector<int> nonfinite = {0};
   cl::Buffer b_r = to_device(rt_, radiance), b_s = to_device(rt_, sum), b_q = to_device(rt_, sumsq),
              b_n = to_device(rt_, nonfinite), b_c = to_device(rt_, counts),
@@ -437,8 +437,8 @@ void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
   k.setArg(a++, b_c);
   k.setArg(a++, b_fc);
   enqueue_1d(rt_.queue(), k, size_t(std::min(npix, wave)));
-  auto dsum = from_device<float4>(rt_, b_s, npix), dsq = from_device<float4>(rt_, b_q, npix);
-  auto dfc = from_device<float2>(rt_, b_fc, npix);
+  auto dsum = from_device<double4>(rt_, b_s, npix), dsq = from_device<double4>(rt_, b_q, npix);
+  auto dfc = from_device<double2>(rt_, b_fc, npix);
   EXPECT_EQ(from_device<int>(rt_, b_n, 1)[0], 2);
   // Reference: visit paths in order, add into their pixel (g mod npix).
   for (int i = 0; i < wave; ++i) {
@@ -446,11 +446,12 @@ void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
     float4 L = radiance[size_t(i)];
     if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z))
       L = make_float4(0, 0, 0, 0);
-    sum[p] = make_float4(sum[p].x + L.x, sum[p].y + L.y, sum[p].z + L.z, sum[p].w + 1);
-    sumsq[p] =
-        make_float4(sumsq[p].x + L.x * L.x, sumsq[p].y + L.y * L.y, sumsq[p].z + L.z * L.z, 0);
-    fc[p].x += float(counts[size_t(i)].x);
-    fc[p].y += float(counts[size_t(i)].y);
+    // The film sums in double: each float sample and its square exactly converted.
+    double x = L.x, y = L.y, z = L.z;
+    sum[p] = double4{sum[p].x + x, sum[p].y + y, sum[p].z + z, sum[p].w + 1};
+    sumsq[p] = double4{sumsq[p].x + x * x, sumsq[p].y + y * y, sumsq[p].z + z * z, 0};
+    fc[p].x += double(counts[size_t(i)].x);
+    fc[p].y += double(counts[size_t(i)].y);
   }
   for (int p = 0; p < npix; ++p) {
     EXPECT_EQ(dsum[size_t(p)].x, sum[size_t(p)].x) << p; // same order of additions: bit-identical

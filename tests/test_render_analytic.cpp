@@ -96,8 +96,8 @@ Check compare_with_analytic(const Scene& scene, const Film& film, float3 albedo)
       float3 ref = pixel_reference(scene, cam, x, y, 16, albedo);
       float3 ref_coarse = pixel_reference(scene, cam, x, y, 8, albedo);
       double n = film.sum[p].w;
-      const float* sum = &film.sum[p].x;
-      const float* sq = &film.sumsq[p].x;
+      const double* sum = &film.sum[p].x;
+      const double* sq = &film.sumsq[p].x;
       const float* r = &ref.x;
       const float* rc = &ref_coarse.x;
       for (int ch = 0; ch < 3; ++ch) {
@@ -154,8 +154,8 @@ TEST_P(AnalyticPlane, PixelMeansMatchTheAnalyticRadiance) {
   rs.wave_size = 1 << 14; // several waves, each holding many samples of every pixel
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
-  for (const float4& s : film.sum)
-    ASSERT_EQ(s.w, 2048.0f);
+  for (const double4& s : film.sum)
+    ASSERT_EQ(s.w, 2048.0);
   Check c = compare_with_analytic(scene, film, albedo);
   std::printf("%s, scale %g: %d values checked, mean relative bound %.4f\n", sampler.c_str(),
               double(scale), c.checked, c.mean_rel_bound);
@@ -335,14 +335,15 @@ TEST_P(AreaLightMis, PixelMeansMatchTheIrradianceIntegral) {
       if (sees_light) continue;
       size_t p = size_t(y) * size_t(film.width) + size_t(x);
       double cnt = film.sum[p].w;
-      double mean = luminance3(xyz_of(film.sum[p])) / cnt;
+      const double4& s = film.sum[p];
+      double mean = (0.2126 * s.x + 0.7152 * s.y + 0.0722 * s.z) / cnt; // luminance3 in double
       // Variance of the luminance from the per-channel moments (channels treated as independent:
       // an upper bound for these positively correlated colour channels is not needed here, the
       // sum of per-channel variances weighted by the squared luminance coefficients).
       double var = 0;
       const float w[3] = {0.2126f, 0.7152f, 0.0722f};
-      const float* sm = &film.sum[p].x;
-      const float* sq = &film.sumsq[p].x;
+      const double* sm = &film.sum[p].x;
+      const double* sq = &film.sumsq[p].x;
       for (int c = 0; c < 3; ++c) {
         double m = sm[c] / cnt;
         var += double(w[c]) * w[c] * std::max(0.0, sq[c] / cnt - m * m) * cnt / (cnt - 1);

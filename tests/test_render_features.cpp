@@ -38,7 +38,7 @@ void expect_identical(const Film& a, const Film& b) {
     differ += a.sum[i].x != b.sum[i].x || a.sum[i].y != b.sum[i].y || a.sum[i].z != b.sum[i].z;
   EXPECT_EQ(differ, 0) << "pixels that differ";
   double total = 0;
-  for (const float4& s : a.sum)
+  for (const double4& s : a.sum)
     total += s.x + s.y + s.z;
   EXPECT_GT(total, 0.0); // the image is not black
 }

@@ -29,7 +29,9 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   float w = 1.0f;
   if (!s.is_delta && f.w > 0.0f) w = power_heuristic(pmf * s.pdf, cos_n * CANOPY_INV_PI);
   float3 c = xyz_of(f) * s.Li * (cos_n * w / (s.pdf * pmf));
-  if (!is_finite_f(c.x + c.y + c.z) || !(max3(c) > 0.0f)) return 0;
+  // A non-finite contribution is kept, not dropped: it reaches the path's radiance, where
+  // accumulate counts the sample as non-finite (reported by --stats) and records it as zero.
+  if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) return 0;
   (void)sc;
   // P is already off the surface (shade_surface). The ray ends short of the light point by the
   // float error of that point's own coordinates and of the distance, not by a scene-wide margin;

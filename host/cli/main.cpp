@@ -105,6 +105,11 @@ int run_render(const RenderArgs& args) {
   bar.finish();
 
   RgbImage img = film.mean();
+  if (uint64_t n = renderer.stats().overflowed_pixels)
+    std::fprintf(stderr,
+                 "canopy: warning: %llu pixels exceed the float range of the image (3.4e38) and "
+                 "are written as the largest finite float\n",
+                 (unsigned long long)n);
   write_exr(exr, img,
             {{"canopy:scene", args.scene},
              {"canopy:light_sampler", scene.integrator.light_sampler},

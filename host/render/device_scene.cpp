@@ -1,16 +1,45 @@
 #include "render/device_scene.h"
 
+#include <cmath>
+
 namespace canopy {
+
+namespace {
+
+// The lights with emission times 2^-k, uploaded in chunks (no second host copy of a light set of
+// 10^7 lights). Emission is read on the device only as radiance/intensity (sample_light,
+// light_emitted_radiance); pmfs and MIS weights use the sampler's own buffers.
+cl::Buffer upload_scaled_lights(const cl::Context& ctx, const std::vector<Light>& lights, int k) {
+  if (k == 0 || lights.empty()) return upload_buffer(ctx, lights);
+  cl::Buffer buf(ctx, CL_MEM_READ_ONLY, lights.size() * sizeof(Light));
+  cl::CommandQueue q(ctx, ctx.getInfo<CL_CONTEXT_DEVICES>().at(0));
+  const size_t chunk = size_t(1) << 16;
+  std::vector<Light> part;
+  for (size_t first = 0; first < lights.size(); first += chunk) {
+    size_t n = std::min(chunk, lights.size() - first);
+    part.assign(lights.begin() + std::ptrdiff_t(first), lights.begin() + std::ptrdiff_t(first + n));
+    for (Light& l : part) {
+      l.emission.x = std::ldexp(l.emission.x, -k);
+      l.emission.y = std::ldexp(l.emission.y, -k);
+      l.emission.z = std::ldexp(l.emission.z, -k);
+    }
+    q.enqueueWriteBuffer(buf, CL_TRUE, first * sizeof(Light), n * sizeof(Light), part.data());
+  }
+  return buf;
+}
+
+} // namespace
 
 DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geometry,
                                 const std::vector<Material>& materials,
-                                const std::vector<Light>& lights, const LightSamplerData& sampler) {
+                                const std::vector<Light>& lights, const LightSamplerData& sampler,
+                                int emission_exponent) {
   DeviceScene d;
   d.nodes = upload_buffer(ctx, geometry.bvh.nodes);
   d.prim_index = upload_buffer(ctx, geometry.bvh.prim_index);
   d.prims = upload_buffer(ctx, geometry.prims);
   d.materials = upload_buffer(ctx, materials);
-  d.lights = upload_buffer(ctx, lights);
+  d.lights = upload_scaled_lights(ctx, lights, emission_exponent);
   d.power_pmf = upload_buffer(ctx, sampler.power_pmf);
   d.alias_prob = upload_buffer(ctx, sampler.alias_prob);
   d.alias_index = upload_buffer(ctx, sampler.alias_index);

@@ -36,8 +36,13 @@ struct DeviceScene {
   int set_light_sampler_args(cl::Kernel& k, int index) const; // LIGHT_SAMPLER_PARAMS
 };
 
+// `emission_exponent` k: the device copy of every light's emission is multiplied by 2^-k (exact for
+// results in float's normal range; see emission_scale_exponent in render/renderer.h). The light
+// sampler's data (pmfs, tree energies) is uploaded as built: it does not depend on the absolute
+// emission, only on ratios.
 DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geometry,
                                 const std::vector<Material>& materials,
-                                const std::vector<Light>& lights, const LightSamplerData& sampler);
+                                const std::vector<Light>& lights, const LightSamplerData& sampler,
+                                int emission_exponent = 0);
 
 } // namespace canopy

@@ -5,7 +5,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cfloat>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace canopy {
@@ -35,18 +37,59 @@ const std::vector<std::string>& wavefront_kernel_files() {
   return kKernelFiles;
 }
 
+int emission_scale_exponent(const std::vector<Light>& lights) {
+  float m = 0.0f;
+  for (const Light& l : lights)
+    for (float c : {l.emission.x, l.emission.y, l.emission.z})
+      if (std::isfinite(c)) m = std::max(m, std::fabs(c));
+  if (!(m > 0.0f)) return 0;
+  // m = f * 2^e with f in [0.5, 1): m * 2^-(e-1) is in [1, 2).
+  int e = 0;
+  std::frexp(m, &e);
+  return e - 1;
+}
+
+namespace {
+
+// One channel of a pixel's mean as float32. The mean of finite samples is finite in double; a
+// value float cannot hold is written as the largest finite float of its sign, never Inf.
+float resolve_channel(double sum, double n, bool* beyond) {
+  double x = sum / n;
+  if (std::fabs(x) > double(FLT_MAX)) {
+    *beyond = true;
+    x = std::copysign(double(FLT_MAX), x);
+  }
+  return float(x);
+}
+
+} // namespace
+
 RgbImage Film::mean() const {
   RgbImage img;
   img.width = width;
   img.height = height;
   img.rgb.resize(size_t(width) * height * 3);
+  bool beyond = false;
   for (size_t p = 0; p < sum.size(); ++p) {
-    float n = sum[p].w > 0.0f ? sum[p].w : 1.0f;
-    img.rgb[3 * p] = sum[p].x / n;
-    img.rgb[3 * p + 1] = sum[p].y / n;
-    img.rgb[3 * p + 2] = sum[p].z / n;
+    double n = sum[p].w > 0.0 ? sum[p].w : 1.0;
+    img.rgb[3 * p] = resolve_channel(sum[p].x, n, &beyond);
+    img.rgb[3 * p + 1] = resolve_channel(sum[p].y, n, &beyond);
+    img.rgb[3 * p + 2] = resolve_channel(sum[p].z, n, &beyond);
   }
   return img;
+}
+
+uint64_t Film::overflowed_pixels() const {
+  uint64_t over = 0;
+  for (const double4& s : sum) {
+    double n = s.w > 0.0 ? s.w : 1.0;
+    bool beyond = false;
+    resolve_channel(s.x, n, &beyond);
+    resolve_channel(s.y, n, &beyond);
+    resolve_channel(s.z, n, &beyond);
+    over += beyond ? 1 : 0;
+  }
+  return over;
 }
 
 RgbImage Film::shadow_ray_heatmap(float max_rays) const {
@@ -56,7 +99,7 @@ RgbImage Film::shadow_ray_heatmap(float max_rays) const {
   img.rgb.assign(size_t(width) * height * 3, 0.0f);
   std::vector<float> v(counts.size());
   for (size_t p = 0; p < counts.size(); ++p)
-    v[p] = counts[p].y > 0 ? counts[p].x / counts[p].y : 0;
+    v[p] = counts[p].y > 0 ? float(counts[p].x / counts[p].y) : 0.0f;
   if (max_rays <= 0.0f) max_rays = std::max(1.0f, *std::max_element(v.begin(), v.end()));
   // A perceptually ordered ramp: black -> blue -> magenta -> orange -> yellow -> white.
   const float3 ramp[] = {{0, 0, 0},          {0.1f, 0.1f, 0.6f}, {0.7f, 0.1f, 0.6f},
@@ -81,9 +124,17 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   stats_.light_tree_seconds = sampler_.tree_build_seconds;
   stats_.build_seconds = seconds_since(t0);
 
+  // The film is accumulated in double (cl/kernels/accumulate.cl).
+  if (rt.device().getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() == 0)
+    throw ClError(fmt::format("device {} has no double precision (cl_khr_fp64), which the film "
+                              "accumulation needs; choose another device with --device",
+                              rt.device_name()));
+
   t0 = Clock::now();
   const cl::Context& ctx = rt.context();
-  device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_);
+  stats_.emission_exponent = emission_scale_exponent(scene.lights);
+  device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
+                                stats_.emission_exponent);
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
   camera_ = upload_buffer(ctx, cam);
@@ -138,16 +189,22 @@ Film Renderer::render(const RenderSettings& settings) {
   cl::Buffer totals = device_buffer(ctx, 2 * sizeof(cl_int));
   cl::Buffer histogram = device_buffer(ctx, kCutBins * sizeof(cl_int));
   cl::Buffer nonfinite = device_buffer(ctx, sizeof(cl_int));
-  cl::Buffer film_sum = device_buffer(ctx, size_t(npix) * sizeof(float4));
-  cl::Buffer film_sumsq = device_buffer(ctx, size_t(npix) * sizeof(float4));
-  cl::Buffer film_counts = device_buffer(ctx, size_t(npix) * sizeof(float2));
+  cl::Buffer film_sum = device_buffer(ctx, size_t(npix) * sizeof(double4));
+  cl::Buffer film_sumsq = device_buffer(ctx, size_t(npix) * sizeof(double4));
+  cl::Buffer film_counts = device_buffer(ctx, size_t(npix) * sizeof(double2));
   cl::Buffer path_counts = device_buffer(ctx, W * sizeof(cl_int2));
-  const float4 zero4 = make_float4(0, 0, 0, 0);
-  q.enqueueFillBuffer(film_sum, zero4, 0, size_t(npix) * sizeof(float4));
-  q.enqueueFillBuffer(film_sumsq, zero4, 0, size_t(npix) * sizeof(float4));
-  q.enqueueFillBuffer(film_counts, cl_float(0), 0, size_t(npix) * sizeof(float2));
-  q.enqueueFillBuffer(nonfinite, cl_int(0), 0, sizeof(cl_int));
-  q.enqueueFillBuffer(histogram, cl_int(0), 0, kCutBins * sizeof(cl_int));
+  q.enqueueFillBuffer(film_sum, cl_double(0), 0, size_t(npix) * sizeof(double4));
+  q.enqueueFillBuffer(film_sumsq, cl_double(0), 0, size_t(npix) * sizeof(double4));
+  q.enqueueFillBuffer(film_counts, cl_double(0), 0, size_t(npix) * sizeof(double2));
+  // The 32-bit device counters (non-finite samples, cut-size histogram) count one wave at a time
+  // (at most W * max_depth events) and are added into the 64-bit stats after each wave: a whole
+  // render at 2^24 spp has more than 2^31 samples.
+  auto reset_counters = [&] {
+    q.enqueueFillBuffer(nonfinite, cl_int(0), 0, sizeof(cl_int));
+    q.enqueueFillBuffer(histogram, cl_int(0), 0, kCutBins * sizeof(cl_int));
+  };
+  reset_counters();
+  std::vector<cl_int> hist(kCutBins);
 
   cl::Kernel k_generate(program_, "generate");
   cl::Kernel k_closest(program_, "intersect_closest");
@@ -324,6 +381,13 @@ Film Renderer::render(const RenderSettings& settings) {
     for (auto& [stage, ev] : events)
       stats_.stages[stage].seconds += event_seconds(ev);
     events.clear();
+    cl_int nf = 0;
+    q.enqueueReadBuffer(nonfinite, CL_FALSE, 0, sizeof(nf), &nf);
+    q.enqueueReadBuffer(histogram, CL_TRUE, 0, kCutBins * sizeof(cl_int), hist.data());
+    stats_.nonfinite_samples += uint64_t(uint32_t(nf));
+    for (int k = 0; k < kCutBins; ++k)
+      stats_.cut_size_histogram[size_t(k)] += uint64_t(uint32_t(hist[size_t(k)]));
+    reset_counters();
     stats_.samples += uint64_t(count0);
     if (settings.progress) settings.progress(double(base + uint64_t(count0)) / double(total));
   }
@@ -334,16 +398,19 @@ Film Renderer::render(const RenderSettings& settings) {
   film.sum.resize(size_t(npix));
   film.sumsq.resize(size_t(npix));
   film.counts.resize(size_t(npix));
-  q.enqueueReadBuffer(film_counts, CL_TRUE, 0, size_t(npix) * sizeof(float2), film.counts.data());
-  q.enqueueReadBuffer(film_sum, CL_TRUE, 0, size_t(npix) * sizeof(float4), film.sum.data());
-  q.enqueueReadBuffer(film_sumsq, CL_TRUE, 0, size_t(npix) * sizeof(float4), film.sumsq.data());
-  cl_int nf = 0;
-  q.enqueueReadBuffer(nonfinite, CL_TRUE, 0, sizeof(nf), &nf);
-  stats_.nonfinite_samples += uint64_t(nf);
-  std::vector<cl_int> hist(kCutBins);
-  q.enqueueReadBuffer(histogram, CL_TRUE, 0, kCutBins * sizeof(cl_int), hist.data());
-  for (int k = 0; k < kCutBins; ++k)
-    stats_.cut_size_histogram[size_t(k)] += uint64_t(hist[size_t(k)]);
+  q.enqueueReadBuffer(film_counts, CL_TRUE, 0, size_t(npix) * sizeof(double2), film.counts.data());
+  q.enqueueReadBuffer(film_sum, CL_TRUE, 0, size_t(npix) * sizeof(double4), film.sum.data());
+  q.enqueueReadBuffer(film_sumsq, CL_TRUE, 0, size_t(npix) * sizeof(double4), film.sumsq.data());
+  // Undo the device's emission scale 2^-k: exact in double (a power of two; the sums of float
+  // samples times 2^k, |k| <= 149 + 128, stay far inside double's range).
+  const int k = stats_.emission_exponent;
+  for (size_t p = 0; p < size_t(npix); ++p) {
+    double4& s = film.sum[p];
+    double4& q2 = film.sumsq[p];
+    s.x = std::ldexp(s.x, k), s.y = std::ldexp(s.y, k), s.z = std::ldexp(s.z, k);
+    q2.x = std::ldexp(q2.x, 2 * k), q2.y = std::ldexp(q2.y, 2 * k), q2.z = std::ldexp(q2.z, 2 * k);
+  }
+  stats_.overflowed_pixels += film.overflowed_pixels();
   stats_.render_seconds += seconds_since(t_start);
   return film;
 }

@@ -39,15 +39,34 @@ struct RenderStats {
   std::vector<uint64_t> cut_size_histogram; // shading points by number of shadow items pushed
   std::string kernel_options;               // the -D options the kernels were compiled with
   uint64_t nonfinite_samples = 0; // samples that were not finite and were recorded as zero
+  // Pixels whose resolved value (film mean) lies beyond the float32 range of the output image:
+  // Film::mean() writes them as +-FLT_MAX, never as Inf.
+  uint64_t overflowed_pixels = 0;
+  // The device renders with every light's emission times 2^-emission_exponent (so the largest is
+  // in [1, 2)); the film is multiplied by 2^emission_exponent in double when read back.
+  int emission_exponent = 0;
   std::map<std::string, StageStats> stages;
 };
 
-// Per-pixel running sums: sum.xyz = radiance sum, sum.w = sample count, sumsq = second moment.
+// The film's double-precision sums (the device's double4/double2 layout).
+struct alignas(32) double4 {
+  double x, y, z, w;
+};
+struct alignas(16) double2 {
+  double x, y;
+};
+static_assert(sizeof(double4) == 32 && sizeof(double2) == 16);
+
+// Per-pixel running sums in double, in the scene's emission units (the device's emission scale
+// already undone): sum.xyz = radiance sum, sum.w = sample count, sumsq = second moment.
 struct Film {
   int width = 0, height = 0;
-  std::vector<float4> sum, sumsq;
-  std::vector<float2> counts; // per pixel: (shadow rays, shading points), summed over samples
+  std::vector<double4> sum, sumsq;
+  std::vector<double2> counts; // per pixel: (shadow rays, shading points), summed over samples
+  // Per-pixel means as float32. A value beyond +-FLT_MAX is written as +-FLT_MAX, never Inf.
   RgbImage mean() const;
+  // Pixels with a channel whose mean is beyond +-FLT_MAX (written clamped by mean()).
+  uint64_t overflowed_pixels() const;
   // Shadow rays per shading point in each pixel, mapped through a false-colour ramp from 0 to
   // `max_rays` (0: the image's maximum) -- Conty Estevez & Kulla 2018, Fig. 18.
   RgbImage shadow_ray_heatmap(float max_rays = 0.0f) const;
@@ -72,10 +91,16 @@ struct RendererOptions {
 // The kernel sources of the wavefront, in build order.
 const std::vector<std::string>& wavefront_kernel_files();
 
+// The power of two k with max_emission * 2^-k in [1, 2), where max_emission is the largest finite
+// emission component of `lights` (0 when there is none): the device renders with emissions times
+// 2^-k so that emissions from the float maximum down to denormals (1e-40) give finite,
+// full-precision per-sample values. Scaling by a power of two is exact.
+int emission_scale_exponent(const std::vector<Light>& lights);
+
 class Renderer {
 public:
   // Builds the geometry and uploads it; compiles the kernels. `scene` lights get their `prim`
-  // fields filled in.
+  // fields filled in. Throws ClError if the device has no double precision (the film needs it).
   Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options);
 
   Film render(const RenderSettings& settings);

@@ -16,6 +16,8 @@ nlohmann::json stats_to_json(const RenderStats& s, const RunTimings& run) {
   j["shadow_rays_per_shading_point"] =
       s.shading_points ? double(s.shadow_rays) / double(s.shading_points) : 0.0;
   j["nonfinite_samples"] = s.nonfinite_samples;
+  j["overflowed_pixels"] = s.overflowed_pixels; // written as +-FLT_MAX
+  j["emission_exponent"] = s.emission_exponent; // the device rendered emission * 2^-k
   j["kernel_options"] = s.kernel_options;
   nlohmann::json stages = nlohmann::json::object();
   for (const auto& [name, st] : s.stages)
@@ -45,10 +47,11 @@ std::string stats_to_table(const RenderStats& s, const RunTimings& run) {
     out += fmt::format("{:<20} {:>10.4f} {:>14} {:>10} {:>14.4g}\n", name, st.seconds, st.items,
                        st.launches, st.seconds > 0.0 ? double(st.items) / st.seconds : 0.0);
   out += fmt::format("samples {}, shading points {}, shadow rays {} ({:.3f} per shading point), "
-                     "non-finite samples {}\n",
+                     "non-finite samples {}, pixels beyond the float range {}, emission scale "
+                     "2^{}\n",
                      s.samples, s.shading_points, s.shadow_rays,
                      s.shading_points ? double(s.shadow_rays) / double(s.shading_points) : 0.0,
-                     s.nonfinite_samples);
+                     s.nonfinite_samples, s.overflowed_pixels, -s.emission_exponent);
   out += "cut sizes:";
   for (size_t k = 0; k < s.cut_size_histogram.size(); ++k)
     if (s.cut_size_histogram[k])
