@@ -294,3 +294,38 @@ TEST_F(KernelLightPicks, TreeDeepLanesBelowOldXiResolution) {
   }
   check(rt, c);
 }
+
+// Finding 2: five lights of intensity 1e-12 beside a 1e12 spot pointing down (10 degree cone).
+// Outside the cone only the small lights can contribute, and they must get the picks there (the
+// old build packed the spot into a leaf with three of them and gave the other two 1e-24); inside
+// it the small lights have probability ~1e-24 (group 1: Poisson bound, i.e. never in 10^6).
+std::vector<Light> spot_and_tiny_lights() {
+  float c = std::cos(10.0f * M_PI_F / 180.0f), ci = std::cos(9.0f * M_PI_F / 180.0f);
+  std::vector<Light> lights = {make_spot_light(make_float3(0, 0, 3), make_float3(0, 0, -1), c, ci,
+                                               make_float3(1e12f, 1e12f, 1e12f))};
+  const float xy[5][2] = {{2.0f, -0.5f}, {2.5f, 0.3f}, {3.0f, -0.2f}, {2.2f, 0.6f}, {2.8f, 0.1f}};
+  for (const auto& q : xy)
+    lights.push_back(
+        make_point_light(make_float3(q[0], q[1], 1.0f), make_float3(1e-12f, 1e-12f, 1e-12f)));
+  return lights;
+}
+
+TEST_F(KernelLightPicks, TreeTinyLightsBesideBrightSpot) {
+  for (float x : {2.5f, 0.0f}) { // outside the spot's cone, inside it
+    Case c{"tree, spot and tiny lights at x = " + std::to_string(x),
+           "tree",
+           spot_and_tiny_lights(),
+           {0, 1, 1, 1, 1, 1},
+           make_float3(x, 0, 0),
+           make_float3(0, 0, 1),
+           1000000,
+           17};
+    check(rt, c);
+    if (x > 0.0f) { // every small light lights P: each needs a real share of the picks
+      LightSamplerData data = make_light_sampler_data(c.lights, "tree", 0.0f, 1);
+      LightSamplerCtx hv = data.host_view(c.lights);
+      for (int l = 1; l < 6; ++l)
+        EXPECT_GT(light_sampler_pmf(&hv, c.P, c.N, l), 0.05f) << "light " << l;
+    }
+  }
+}
