@@ -4,7 +4,10 @@
 #include "lighttree/light_sampler.h"
 #include "lighttree/synthetic_lights.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <string>
 #include <vector>
 
 namespace canopy::test {
@@ -126,6 +129,88 @@ inline double chi2_score(const std::vector<double>& observed, const std::vector<
   int k = std::max(1, bins - 1);
   if (dof) *dof = k;
   return chi2_z(chi2, k);
+}
+
+// Goodness of fit of pick counts against the probabilities the sampler reports, at significance
+// alpha = 1e-6 (fixed seeds: a correct sampler fails with probability 1e-6, never in practice).
+// Lights are split by `group` (bins never mix groups, so a small population is judged on its
+// own), sorted by probability within a group and merged into bins of expected count >=
+// min_expected (a trailing remainder joins the group's last bin). The chi-square over all bins is
+// compared with its 1 - alpha quantile (Wilson-Hilferty). A group whose whole expected count is
+// below min_expected cannot form a bin: its observed count must stay below the Poisson 1 - alpha
+// quantile of its expectation. A pick of a light of probability 0 always fails.
+struct PickFit {
+  double chi2 = 0, quantile = 0;
+  int dof = 0;
+  std::string failures; // rare groups over their bound, impossible picks
+  bool pass() const { return failures.empty() && chi2 <= quantile; }
+};
+inline double poisson_upper(double lambda, double alpha) { // smallest q with P(X > q) <= alpha
+  double term = std::exp(-lambda), cdf = term;
+  int q = 0;
+  while (1.0 - cdf > alpha && q < 100000) {
+    ++q;
+    term *= lambda / q;
+    cdf += term;
+  }
+  return q;
+}
+inline PickFit pick_fit(const std::vector<double>& counts, const std::vector<double>& prob,
+                        const std::vector<int>& group, double total, double min_expected = 20.0) {
+  const double z = 4.753424; // standard normal 1 - 1e-6 quantile
+  PickFit f;
+  std::vector<int> order(counts.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return group[a] != group[b] ? group[a] < group[b] : prob[a] < prob[b];
+  });
+  std::vector<double> bo, be; // observed, expected per bin
+  size_t i = 0;
+  int bins = 0;
+  while (i < order.size()) {
+    int g = group[order[i]];
+    size_t end = i;
+    double go = 0, ge = 0;
+    while (end < order.size() && group[order[end]] == g) {
+      int l = order[end++];
+      if (!(prob[l] > 0) && counts[l] > 0)
+        f.failures += "light " + std::to_string(l) + " has probability 0 but was picked; ";
+      go += counts[l];
+      ge += prob[l] * total;
+    }
+    if (ge < min_expected) {
+      double bound = poisson_upper(ge, 1e-6);
+      if (go > bound)
+        f.failures += "group " + std::to_string(g) + ": " + std::to_string(go) +
+                      " picks, expected " + std::to_string(ge) + " (bound " +
+                      std::to_string(bound) + "); ";
+      i = end;
+      continue;
+    }
+    size_t first_bin = bo.size();
+    double o = 0, e = 0;
+    for (; i < end; ++i) {
+      int l = order[i];
+      o += counts[l];
+      e += prob[l] * total;
+      if (e >= min_expected) {
+        bo.push_back(o);
+        be.push_back(e);
+        o = e = 0;
+      }
+    }
+    if (e > 0 || o > 0) { // remainder joins the group's last bin (there is one: ge >= min)
+      bo.back() += o;
+      be.back() += e;
+    }
+    bins += int(bo.size() - first_bin);
+  }
+  for (size_t b = 0; b < bo.size(); ++b)
+    f.chi2 += (bo[b] - be[b]) * (bo[b] - be[b]) / be[b];
+  f.dof = std::max(1, bins - 1);
+  double k = f.dof, h = 2.0 / (9.0 * k);
+  f.quantile = k * std::pow(1.0 - h + z * std::sqrt(h), 3.0);
+  return f;
 }
 
 } // namespace canopy::test

@@ -158,6 +158,9 @@ inline float m_omega(const HCone& c) {
   return lt_m_omega(c.to, c.te);
 }
 
+// Largest ratio of emitter energies that leaf packing may put together (see similar_energies).
+constexpr float kPackEnergyRatio = 1024.0f;
+
 struct Prim {
   float3 bmin, bmax, c;
   HCone cone;
@@ -274,7 +277,7 @@ public:
     // leaf_size (halving the number of leaves). Fuller leaves and fuller 4-wide nodes keep the
     // tree with its emitter records under 64 bytes/emitter, and skip the SAOH binning where it
     // matters least (the emitters of a leaf are ranked individually by their records anyway).
-    if (n <= kPackLeaves * opt_.leaf_size) {
+    if (n <= kPackLeaves * opt_.leaf_size && similar_energies(begin, end)) {
       int leaves = (n + opt_.leaf_size - 1) / opt_.leaf_size;
       int m = begin + opt_.leaf_size * ((leaves + 1) / 2);
       float3 ce = acc.cmax - acc.cmin;
@@ -418,6 +421,22 @@ private:
   }
 
   std::vector<Prim>& prims_;
+  // Packing ignores energy: it would put a bright emitter in one leaf with dim ones beside it, and
+  // the leaf's importance (its summed energy, its union cone) then hides them wherever the bright
+  // one does not reach (a 1e12 spot beside 1e-12 lights: their pmf is 1e-24 where only they
+  // shine). Clusters whose positive energies span more than kPackEnergyRatio go through SAOH,
+  // whose cost (energy x orientation x area) separates them.
+  bool similar_energies(int begin, int end) const {
+    float lo = FLT_MAX, hi = 0.0f;
+    for (int i = begin; i < end; ++i) {
+      float e = prims_[size_t(i)].e;
+      if (!(e > 0.0f)) continue;
+      lo = std::min(lo, e);
+      hi = std::max(hi, e);
+    }
+    return !(hi > kPackEnergyRatio * lo);
+  }
+
   BinaryLightNode* nodes_; // room for 2n - 1 nodes, written in place (see the caller)
   const LightTreeBuildOptions& opt_;
 };
