@@ -325,7 +325,11 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       EXPECT_EQ(passes, 1);
       EXPECT_EQ(split_items, 0);
     }
-    paths = ref; // the next depth starts from the shaded state
+    paths = ref; // the next depth starts from the shaded state and the bounce rays' hits
+    for (size_t i = 0; i < paths.hits.size(); ++i)
+      bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
+                    geometry_.prims.data(), xyz_of(paths.ray_o[i]), xyz_of(paths.ray_d[i]),
+                    paths.ray_o[i].w, FLT_INF, 0, &paths.hits[i]);
   }
 }
 

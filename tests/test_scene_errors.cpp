@@ -312,8 +312,8 @@ TEST(SceneErrors, SpotConeZero) {
 
 TEST(SceneErrors, SpotFalloffBeyondCone) {
   EXPECT_EQ(light_error(R"({"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0],
-                             "intensity": 1, "cone_angle": 30, "falloff_start": 30})"),
-            "scene.json: lights[0].falloff_start: must be in [0, cone_angle)");
+                             "intensity": 1, "cone_angle": 30, "falloff_start": 30.5})"),
+            "scene.json: lights[0].falloff_start: must be in [0, cone_angle]");
 }
 
 TEST(SceneErrors, NoEmitters) {
