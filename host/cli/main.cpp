@@ -276,7 +276,10 @@ int main(int argc, char** argv) {
   render->add_option("scene", rargs.scene, "Scene file (JSON, see docs/scene-format.md)")
       ->required();
   render->add_option("--spp", rargs.spp, "Samples per pixel (overrides the scene)");
-  render->add_option("--out", rargs.out, "Output EXR (default out/<scene>.exr)");
+  render->add_option("--out", rargs.out,
+                     "Output image: FILE.exr, or FILE.png; the other format is written beside it "
+                     "with the other extension (default out/<scene>.exr). Written to a temporary "
+                     "file in the same directory, then renamed");
   render->add_option("--png", rargs.png, "Output PNG (default: the EXR path with .png)");
   render->add_option("--seed", rargs.seed, "Random seed (overrides the scene)");
   render->add_option("--light-sampler", rargs.light_sampler, "Light sampler (overrides the scene)")
