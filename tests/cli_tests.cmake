@@ -26,3 +26,89 @@ add_test(NAME cli_no_orientation_needs_a_tree
           "-DEXPECT=--no-orientation: applies to the tree samplers only (tree, tree-split), not power"
           -P ${CMAKE_CURRENT_SOURCE_DIR}/check_exit2.cmake)
 set_tests_properties(cli_no_orientation_needs_a_tree PROPERTIES LABELS cli TIMEOUT 120)
+
+# ---------------------------------------------------------------- issue 9: input that cannot crash
+# or hang, outputs written atomically, reasonable input accepted (docs/limits.md).
+set(CANOPY_CHECK2 ${CMAKE_CURRENT_SOURCE_DIR}/check_exit2.cmake)
+set(CANOPY_CHECK_CLI ${CMAKE_CURRENT_SOURCE_DIR}/check_cli.cmake)
+set(CANOPY_LIMITS_DATA ${CMAKE_CURRENT_SOURCE_DIR}/data/limits)
+set(CANOPY_SCRATCH ${CMAKE_CURRENT_BINARY_DIR}/cli_scratch)
+file(MAKE_DIRECTORY ${CANOPY_SCRATCH})
+# ARGS, FILES, MAGIC and ENV lists are written with "|" (a ";" would split them here).
+function(canopy_cli_test name)
+  add_test(NAME ${name} COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:canopy> ${ARGN})
+  set_tests_properties(${name} PROPERTIES LABELS cli TIMEOUT 120)
+endfunction()
+
+# A FIFO as the scene path: refused at once (it used to block forever in open()).
+canopy_cli_test(cli_scene_fifo -DSCENE=${CANOPY_SCRATCH}/fifo_scene.json -DMKFIFO=ON -DTIMEOUT=10
+  "-DEXPECT=${CANOPY_SCRATCH}/fifo_scene.json: cannot open file (it is a FIFO, not a regular file)"
+  -P ${CANOPY_CHECK2})
+# A character device: refused (it used to be read without bound).
+canopy_cli_test(cli_scene_dev_zero -DSCENE=/dev/zero -DTIMEOUT=10
+  "-DEXPECT=/dev/zero: cannot open file (it is a character device, not a regular file)"
+  -P ${CANOPY_CHECK2})
+# A scene file over the size limit (a sparse file: no disk space used).
+canopy_cli_test(cli_scene_too_large -DSCENE=${CANOPY_SCRATCH}/large_scene.json -DSPARSE=268435457
+  -DTIMEOUT=10
+  "-DEXPECT=${CANOPY_SCRATCH}/large_scene.json: file is too large (268435457 bytes, the limit is 256 MiB)"
+  -P ${CANOPY_CHECK2})
+# NaN and infinity on the command line.
+canopy_cli_test(cli_split_threshold_nan -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  "-DARGS=--split-threshold|nan"
+  "-DEXPECT=canopy: --split-threshold: must be a finite number (see --help)" -P ${CANOPY_CHECK2})
+canopy_cli_test(cli_split_threshold_inf -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  "-DARGS=--split-threshold|inf"
+  "-DEXPECT=canopy: --split-threshold: must be a finite number (see --help)" -P ${CANOPY_CHECK2})
+# A CLI11 parse error is one line.
+canopy_cli_test(cli_parse_error_one_line -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  "-DARGS=--spp|many" "-DEXPECT=canopy: Could not convert: --spp = many (see --help)"
+  -P ${CANOPY_CHECK2})
+# A film too large for the device: one line naming the buffer, its bytes and the limit, exit 2,
+# before any rendering (it used to die with std::bad_alloc after a minute).
+canopy_cli_test(cli_film_exceeds_device -DSCENE=${CANOPY_LIMITS_DATA}/huge_film.json
+  -DENV=POCL_MEMORY_LIMIT=1 -DPREFIX=ON -DTIMEOUT=30
+  "-DEXPECT=${CANOPY_LIMITS_DATA}/huge_film.json: device buffer film_sum needs 4294967296 bytes (4.00 GiB), more than the device's largest allocation (CL_DEVICE_MAX_MEM_ALLOC_SIZE "
+  -P ${CANOPY_CHECK2})
+# Too many lights for the device (it used to fail with a bare "canopy: clCreateBuffer").
+canopy_cli_test(cli_lights_exceed_device -DSCENE=${CANOPY_LIMITS_DATA}/many_lights.json
+  -DENV=POCL_MEMORY_LIMIT=1 -DPREFIX=ON -DTIMEOUT=30
+  "-DEXPECT=${CANOPY_LIMITS_DATA}/many_lights.json: device buffer lights needs 288000000 bytes (274.7 MiB), more than the device's largest allocation (CL_DEVICE_MAX_MEM_ALLOC_SIZE "
+  -P ${CANOPY_CHECK2})
+
+# Outputs: replaced only by rename (the previous file is never written into).
+canopy_cli_test(cli_output_atomic -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  -DDIR=${CANOPY_SCRATCH}/atomic -P ${CMAKE_CURRENT_SOURCE_DIR}/check_output_atomic.cmake)
+# An unwritable --out is refused before rendering.
+file(WRITE ${CANOPY_SCRATCH}/not_a_dir "")
+canopy_cli_test(cli_out_unwritable -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  "-DARGS=--out|${CANOPY_SCRATCH}/not_a_dir/x.exr" -DTIMEOUT=10
+  "-DEXPECT=--out: ${CANOPY_SCRATCH}/not_a_dir/x.exr: its directory ${CANOPY_SCRATCH}/not_a_dir is not a directory"
+  -P ${CANOPY_CHECK2})
+# --out x.png: the PNG there and the EXR beside it, each in its own format.
+canopy_cli_test(cli_out_png
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--out|${CANOPY_SCRATCH}/outpng/x.png"
+  "-DFILES=${CANOPY_SCRATCH}/outpng/x.png|${CANOPY_SCRATCH}/outpng/x.exr"
+  "-DMAGIC=89504e47|762f3101" -P ${CANOPY_CHECK_CLI})
+# --png with another extension is refused (it would write a PNG under that name).
+canopy_cli_test(cli_png_wrong_extension -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  "-DARGS=--out|${CANOPY_SCRATCH}/a.exr|--png|${CANOPY_SCRATCH}/a.exr"
+  "-DEXPECT=--png: ${CANOPY_SCRATCH}/a.exr: must end in .png" -P ${CANOPY_CHECK2})
+
+# Reasonable input accepted: lights switched off are skipped and counted; count 0 light sets.
+canopy_cli_test(cli_lights_switched_off
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/off_lights.json|--out|${CANOPY_SCRATCH}/off.exr"
+  "-DSTDERR=1 lights (4 with zero emission skipped)" "-DFILES=${CANOPY_SCRATCH}/off.exr"
+  -P ${CANOPY_CHECK_CLI})
+# No emitters: a black image, a one-line warning, exit 0.
+canopy_cli_test(cli_no_emitters
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/no_emitters.json|--out|${CANOPY_SCRATCH}/black.exr"
+  "-DSTDERR=canopy: warning: ${CANOPY_LIMITS_DATA}/no_emitters.json: the scene has no emitters; the image is black"
+  "-DFILES=${CANOPY_SCRATCH}/black.exr" -P ${CANOPY_CHECK_CLI})
+# --spp above 10^6 (the scene format allows 2^24).
+canopy_cli_test(cli_spp_above_a_million
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--spp|1048576|--out|${CANOPY_SCRATCH}/spp.exr"
+  "-DSTDERR=2x2, 1048576 spp" -DTIMEOUT=60 -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_spp_above_format_limit -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  "-DARGS=--spp|16777217" "-DEXPECT=--spp: must be in [1, 16777216], got 16777217"
+  -P ${CANOPY_CHECK2})

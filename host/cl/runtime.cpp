@@ -36,6 +36,74 @@ std::filesystem::path executable_dir() {
 
 } // namespace
 
+const char* cl_error_name(cl_int code) {
+  switch (code) {
+#define CANOPY_CL_ERR(x)                                                                           \
+  case x:                                                                                          \
+    return #x;
+    CANOPY_CL_ERR(CL_DEVICE_NOT_FOUND)
+    CANOPY_CL_ERR(CL_DEVICE_NOT_AVAILABLE)
+    CANOPY_CL_ERR(CL_COMPILER_NOT_AVAILABLE)
+    CANOPY_CL_ERR(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    CANOPY_CL_ERR(CL_OUT_OF_RESOURCES)
+    CANOPY_CL_ERR(CL_OUT_OF_HOST_MEMORY)
+    CANOPY_CL_ERR(CL_PROFILING_INFO_NOT_AVAILABLE)
+    CANOPY_CL_ERR(CL_MEM_COPY_OVERLAP)
+    CANOPY_CL_ERR(CL_IMAGE_FORMAT_MISMATCH)
+    CANOPY_CL_ERR(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+    CANOPY_CL_ERR(CL_BUILD_PROGRAM_FAILURE)
+    CANOPY_CL_ERR(CL_MAP_FAILURE)
+    CANOPY_CL_ERR(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+    CANOPY_CL_ERR(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+    CANOPY_CL_ERR(CL_COMPILE_PROGRAM_FAILURE)
+    CANOPY_CL_ERR(CL_LINKER_NOT_AVAILABLE)
+    CANOPY_CL_ERR(CL_LINK_PROGRAM_FAILURE)
+    CANOPY_CL_ERR(CL_INVALID_VALUE)
+    CANOPY_CL_ERR(CL_INVALID_DEVICE_TYPE)
+    CANOPY_CL_ERR(CL_INVALID_PLATFORM)
+    CANOPY_CL_ERR(CL_INVALID_DEVICE)
+    CANOPY_CL_ERR(CL_INVALID_CONTEXT)
+    CANOPY_CL_ERR(CL_INVALID_QUEUE_PROPERTIES)
+    CANOPY_CL_ERR(CL_INVALID_COMMAND_QUEUE)
+    CANOPY_CL_ERR(CL_INVALID_HOST_PTR)
+    CANOPY_CL_ERR(CL_INVALID_MEM_OBJECT)
+    CANOPY_CL_ERR(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+    CANOPY_CL_ERR(CL_INVALID_IMAGE_SIZE)
+    CANOPY_CL_ERR(CL_INVALID_SAMPLER)
+    CANOPY_CL_ERR(CL_INVALID_BINARY)
+    CANOPY_CL_ERR(CL_INVALID_BUILD_OPTIONS)
+    CANOPY_CL_ERR(CL_INVALID_PROGRAM)
+    CANOPY_CL_ERR(CL_INVALID_PROGRAM_EXECUTABLE)
+    CANOPY_CL_ERR(CL_INVALID_KERNEL_NAME)
+    CANOPY_CL_ERR(CL_INVALID_KERNEL_DEFINITION)
+    CANOPY_CL_ERR(CL_INVALID_KERNEL)
+    CANOPY_CL_ERR(CL_INVALID_ARG_INDEX)
+    CANOPY_CL_ERR(CL_INVALID_ARG_VALUE)
+    CANOPY_CL_ERR(CL_INVALID_ARG_SIZE)
+    CANOPY_CL_ERR(CL_INVALID_KERNEL_ARGS)
+    CANOPY_CL_ERR(CL_INVALID_WORK_DIMENSION)
+    CANOPY_CL_ERR(CL_INVALID_WORK_GROUP_SIZE)
+    CANOPY_CL_ERR(CL_INVALID_WORK_ITEM_SIZE)
+    CANOPY_CL_ERR(CL_INVALID_GLOBAL_OFFSET)
+    CANOPY_CL_ERR(CL_INVALID_EVENT_WAIT_LIST)
+    CANOPY_CL_ERR(CL_INVALID_EVENT)
+    CANOPY_CL_ERR(CL_INVALID_OPERATION)
+    CANOPY_CL_ERR(CL_INVALID_GL_OBJECT)
+    CANOPY_CL_ERR(CL_INVALID_BUFFER_SIZE)
+    CANOPY_CL_ERR(CL_INVALID_MIP_LEVEL)
+    CANOPY_CL_ERR(CL_INVALID_GLOBAL_WORK_SIZE)
+    CANOPY_CL_ERR(CL_INVALID_PROPERTY)
+#undef CANOPY_CL_ERR
+  default:
+    return "unknown OpenCL error";
+  }
+}
+
+std::string describe_cl_error(const cl::Error& e, const std::string& context) {
+  return fmt::format("{} failed with {} ({}){}{}", e.what(), cl_error_name(e.err()), e.err(),
+                     context.empty() ? "" : ": ", context);
+}
+
 static void configure_pocl() {
   // PoCL specialises each kernel's work-group function for the grid size by default; the wavefront
   // launches kernels over queues whose length changes every time, so a render compiled thousands
@@ -162,11 +230,21 @@ cl::Program ClRuntime::build_program(const std::vector<std::string>& files,
 cl::Event enqueue_1d(cl::CommandQueue& q, const cl::Kernel& k, size_t n, size_t local) {
   cl::Event ev;
   if (n == 0) return ev;
-  if (local > 0) {
-    size_t global = (n + local - 1) / local * local;
-    q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(local), nullptr, &ev);
-  } else {
-    q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NullRange, nullptr, &ev);
+  size_t global = local > 0 ? (n + local - 1) / local * local : n;
+  try {
+    if (local > 0)
+      q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(global), cl::NDRange(local), nullptr,
+                             &ev);
+    else
+      q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NullRange, nullptr, &ev);
+  } catch (const cl::Error& e) {
+    std::string name("?");
+    try {
+      name = k.getInfo<CL_KERNEL_FUNCTION_NAME>();
+    } catch (const cl::Error&) { // keep "?": the error being reported matters more
+    }
+    throw ClError(describe_cl_error(
+        e, fmt::format("kernel {} over {} work items (local size {})", name, global, local)));
   }
   return ev;
 }

@@ -16,6 +16,13 @@ public:
   using std::runtime_error::runtime_error;
 };
 
+// The symbolic name of an OpenCL error code, e.g. "CL_MEM_OBJECT_ALLOCATION_FAILURE".
+const char* cl_error_name(cl_int code);
+
+// A one-line description of a failed OpenCL call: "clCreateBuffer failed with
+// CL_INVALID_BUFFER_SIZE (-61)" plus `context` (the buffer or kernel and its size) if given.
+std::string describe_cl_error(const cl::Error& e, const std::string& context = "");
+
 struct DeviceInfo {
   int platform_index;
   int device_index;

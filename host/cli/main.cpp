@@ -4,11 +4,13 @@
 //   canopy info
 //   canopy compare A.exr B.exr      (cli/compare_command.cpp)
 //   canopy converge SCENE ...       (cli/converge_command.cpp)
-// Exit codes: 0 success, 2 invalid input (scene or arguments), 1 runtime failure.
+// Exit codes: 0 success, 2 invalid input (scene or arguments, unwritable outputs, work that does
+// not fit the device's or host's memory), 1 runtime failure (OpenCL errors and the like).
 #include "cl/runtime.h"
 #include "cli/compare_command.h"
 #include "cli/converge_command.h"
 #include "image/image_io.h"
+#include "render/memory_budget.h"
 #include "render/renderer.h"
 #include "render/stats_report.h"
 #include "scene/scene.h"
@@ -16,11 +18,17 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <unistd.h>
 
 namespace {
 
@@ -67,6 +75,72 @@ private:
   bool shown_ = false;
 };
 
+std::string lower_ext(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+// The EXR and PNG paths. --out names the EXR (FILE.exr) or the PNG (FILE.png); the other format is
+// written beside it with the other extension unless --png names the PNG. Each format is written
+// once, and never under the other's extension.
+std::pair<fs::path, fs::path> output_paths(const RenderArgs& args) {
+  fs::path stem = fs::path(args.scene).stem();
+  fs::path exr, png;
+  if (args.out.empty()) {
+    exr = fs::path("out") / (stem.string() + ".exr");
+  } else {
+    fs::path out(args.out);
+    std::string e = lower_ext(out);
+    if (e == ".exr") {
+      exr = out;
+    } else if (e == ".png") {
+      if (!args.png.empty())
+        throw SceneError(fmt::format("--out: {}: names a PNG and so does --png; give --out an "
+                                     ".exr name",
+                                     printable(args.out, 1024)));
+      png = out;
+      exr = fs::path(out).replace_extension(".exr");
+    } else {
+      throw SceneError(
+          fmt::format("--out: {}: must end in .exr or .png", printable(args.out, 1024)));
+    }
+  }
+  if (!args.png.empty()) {
+    if (lower_ext(args.png) != ".png")
+      throw SceneError(fmt::format("--png: {}: must end in .png", printable(args.png, 1024)));
+    png = args.png;
+  }
+  if (png.empty()) png = fs::path(exr).replace_extension(".png");
+  return {exr, png};
+}
+
+// Checked before rendering so a render never runs for nothing: the file is a regular file or
+// absent, and its directory exists (it is created if missing) and takes a new file.
+void check_writable(const fs::path& file, const char* option) {
+  auto fail = [&](const std::string& problem) {
+    throw SceneError(fmt::format("{}: {}: {}", option, printable(file.string(), 1024), problem));
+  };
+  std::error_code ec;
+  fs::file_status st = fs::status(file, ec);
+  if (fs::exists(st) && !fs::is_regular_file(st)) fail("exists and is not a regular file");
+  fs::path dir = file.parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::exists(dir, ec)) {
+    fs::create_directories(dir, ec);
+    if (ec) fail(fmt::format("cannot create the directory ({})", ec.message()));
+  }
+  if (!fs::is_directory(dir, ec))
+    fail(fmt::format("its directory {} is not a directory", printable(dir.string(), 1024)));
+  std::string probe = (dir / ".canopy-write-test-XXXXXX").string();
+  std::vector<char> name(probe.begin(), probe.end());
+  name.push_back('\0');
+  int fd = ::mkstemp(name.data());
+  if (fd < 0) fail(fmt::format("the directory is not writable ({})", std::strerror(errno)));
+  ::close(fd);
+  ::unlink(name.data());
+}
+
 int run_render(const RenderArgs& args) {
   auto t_start = std::chrono::steady_clock::now();
   Scene scene = load_scene(args.scene);
@@ -74,8 +148,8 @@ int run_render(const RenderArgs& args) {
   timings.load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (args.spp) {
-    if (*args.spp < 1 || *args.spp > 1000000)
-      throw SceneError(fmt::format("--spp: must be in [1, 1000000], got {}", *args.spp));
+    if (*args.spp < 1 || *args.spp > kMaxSpp)
+      throw SceneError(fmt::format("--spp: must be in [1, {}], got {}", kMaxSpp, *args.spp));
     scene.integrator.spp = *args.spp;
   }
   if (args.seed) scene.integrator.seed = *args.seed;
@@ -86,11 +160,32 @@ int run_render(const RenderArgs& args) {
         "--no-orientation: applies to the tree samplers only (tree, tree-split), not {}",
         scene.integrator.light_sampler));
 
-  fs::path stem = fs::path(args.scene).stem();
-  fs::path exr = args.out.empty() ? fs::path("out") / (stem.string() + ".exr") : fs::path(args.out);
-  fs::path png = args.png.empty() ? fs::path(exr).replace_extension(".png") : fs::path(args.png);
+  auto [exr, png] = output_paths(args);
+  check_writable(exr, args.out.empty() ? "output" : "--out");
+  check_writable(png, args.png.empty() ? "output" : "--png");
+  if (!args.heatmap.empty()) {
+    if (lower_ext(args.heatmap) != ".png")
+      throw SceneError(
+          fmt::format("--heatmap: {}: must end in .png", printable(args.heatmap, 1024)));
+    fs::path h(args.heatmap);
+    if (h == exr || h == png)
+      throw SceneError(
+          fmt::format("--heatmap: {}: is also the image output", printable(args.heatmap, 1024)));
+    check_writable(h, "--heatmap");
+  }
+  if (!args.stats_json.empty()) check_writable(args.stats_json, "--stats-json");
+
+  const std::string scene_name = printable(args.scene, 1024);
+  if (scene.lights.empty())
+    std::fprintf(
+        stderr, "canopy: warning: %s: the scene has no emitters%s; the image is black\n",
+        scene_name.c_str(),
+        scene.skipped_lights
+            ? fmt::format(" ({} lights with zero emission skipped)", scene.skipped_lights).c_str()
+            : "");
 
   ClRuntime rt(args.device);
+  check_scene_memory(rt.device(), scene);
   RendererOptions ropt;
   ropt.light_sampler = scene.integrator.light_sampler;
   ropt.split_threshold = scene.integrator.split_threshold;
@@ -120,9 +215,13 @@ int run_render(const RenderArgs& args) {
   write_png(png, img);
   if (!args.heatmap.empty()) write_png(args.heatmap, film.shadow_ray_heatmap());
   const RenderStats& st = renderer.stats();
-  std::fprintf(stderr, "%s: %dx%d, %d spp, %zu lights, %zu primitives on %s\n", args.scene.c_str(),
-               scene.film.width, scene.film.height, scene.integrator.spp, scene.lights.size(),
-               renderer.geometry().prims.size(), rt.device_name().c_str());
+  std::string skipped = scene.skipped_lights
+                            ? fmt::format(" ({} with zero emission skipped)", scene.skipped_lights)
+                            : std::string();
+  std::fprintf(stderr, "%s: %dx%d, %d spp, %zu lights%s, %zu primitives on %s\n",
+               scene_name.c_str(), scene.film.width, scene.film.height, scene.integrator.spp,
+               scene.lights.size(), skipped.c_str(), renderer.geometry().prims.size(),
+               rt.device_name().c_str());
   std::fprintf(stderr, "build %.3f s, compile %.3f s, render %.3f s%s\n", st.build_seconds,
                st.compile_seconds, st.render_seconds,
                st.nonfinite_samples
@@ -143,7 +242,8 @@ int run_render(const RenderArgs& args) {
     if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.stats_json));
     out << j.dump(2) << "\n";
   }
-  std::printf("wrote %s\nwrote %s\n", exr.string().c_str(), png.string().c_str());
+  std::printf("wrote %s\nwrote %s\n", printable(exr.string(), 1024).c_str(),
+              printable(png.string(), 1024).c_str());
   return 0;
 }
 
@@ -165,6 +265,15 @@ int run_info() {
 
 int main(int argc, char** argv) {
   CLI::App app{"Canopy: a many-light path tracer on OpenCL"};
+  // CLI11 reads "nan" and "inf" as numbers, and NaN passes every range check.
+  const CLI::Validator finite_number(
+      [](std::string& s) -> std::string {
+        char* end = nullptr;
+        double d = std::strtod(s.c_str(), &end);
+        if (end == s.c_str() || *end != '\0' || !std::isfinite(d)) return "must be a finite number";
+        return {};
+      },
+      "FINITE");
   app.require_subcommand(1);
 
   RenderArgs rargs;
@@ -172,7 +281,10 @@ int main(int argc, char** argv) {
   render->add_option("scene", rargs.scene, "Scene file (JSON, see docs/scene-format.md)")
       ->required();
   render->add_option("--spp", rargs.spp, "Samples per pixel (overrides the scene)");
-  render->add_option("--out", rargs.out, "Output EXR (default out/<scene>.exr)");
+  render->add_option("--out", rargs.out,
+                     "Output image: FILE.exr, or FILE.png; the other format is written beside it "
+                     "with the other extension (default out/<scene>.exr). Written to a temporary "
+                     "file in the same directory, then renamed");
   render->add_option("--png", rargs.png, "Output PNG (default: the EXR path with .png)");
   render->add_option("--seed", rargs.seed, "Random seed (overrides the scene)");
   render->add_option("--light-sampler", rargs.light_sampler, "Light sampler (overrides the scene)")
@@ -180,6 +292,7 @@ int main(int argc, char** argv) {
   render
       ->add_option("--split-threshold", rargs.split_threshold,
                    "tree-split threshold in [0, 1] (overrides the scene; 0 never splits)")
+      ->check(finite_number)
       ->check(CLI::Range(0.0, 1.0));
   render->add_flag("--no-orientation", rargs.no_orientation,
                    "Tree samplers: rank clusters by energy / distance^2 only (ablation of the "
@@ -202,7 +315,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    // One line, whatever the user typed (CLI11's own messages may quote it raw).
+    std::fprintf(stderr, "canopy: %s (see --help)\n",
+                 printable(e.what(), std::string::npos).c_str());
     return kExitBadInput;
   }
 
@@ -213,8 +328,18 @@ int main(int argc, char** argv) {
   } catch (const SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
+  } catch (const MemoryLimitError& e) {
+    std::fprintf(stderr, "%s\n", printable(e.what(), std::string::npos).c_str());
+    return kExitBadInput;
+  } catch (const cl::Error& e) {
+    std::fprintf(stderr, "canopy: OpenCL: %s\n",
+                 printable(describe_cl_error(e), std::string::npos).c_str());
+    return kExitRuntime;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "canopy: out of host memory (see docs/limits.md)\n");
+    return kExitRuntime;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "canopy: %s\n", e.what());
+    std::fprintf(stderr, "canopy: %s\n", printable(e.what(), std::string::npos).c_str());
     return kExitRuntime;
   }
   return 0;

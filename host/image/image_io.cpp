@@ -4,8 +4,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
 #include <stdexcept>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace canopy {
 
@@ -16,15 +22,88 @@ float srgb_encode(float x) {
 
 namespace {
 
+mode_t current_umask() {
+  mode_t m = ::umask(0);
+  ::umask(m);
+  return m;
+}
+
+// The temporary file being written, for the signal handler: on SIGINT/SIGTERM/SIGHUP during a
+// write it is removed (unlink is async-signal-safe) and the signal re-raised with its default
+// action, so an interrupted write leaves neither a partial file nor a stray temporary.
+char g_temp_path[4096];
+volatile sig_atomic_t g_temp_active = 0;
+
+extern "C" void remove_temp_and_reraise(int sig) {
+  if (g_temp_active) ::unlink(g_temp_path);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+class TempFileGuard {
+public:
+  explicit TempFileGuard(const std::string& path) : path_(path) {
+    if (path.size() < sizeof(g_temp_path)) {
+      std::memcpy(g_temp_path, path.c_str(), path.size() + 1);
+      g_temp_active = 1;
+    }
+    struct sigaction sa {};
+    sa.sa_handler = remove_temp_and_reraise;
+    sigemptyset(&sa.sa_mask);
+    for (int i = 0; i < 3; ++i)
+      ::sigaction(kSignals[i], &sa, &old_[i]);
+  }
+  ~TempFileGuard() {
+    for (int i = 0; i < 3; ++i)
+      ::sigaction(kSignals[i], &old_[i], nullptr);
+    if (!committed_) ::unlink(path_.c_str());
+    g_temp_active = 0;
+  }
+  void commit() { committed_ = true; }
+
+private:
+  static constexpr int kSignals[3] = {SIGINT, SIGTERM, SIGHUP};
+  std::string path_;
+  struct sigaction old_[3];
+  bool committed_ = false;
+};
+
+// Writes through a temporary file in the destination directory, then rename(2)s it over `file`:
+// a reader (or a second render to the same path) sees the previous image or the new one, never a
+// partial file, and an interrupted write leaves the previous file intact.
 void write_pixels(const std::filesystem::path& file, const OIIO::ImageSpec& spec,
                   OIIO::TypeDesc type, const void* data) {
   std::filesystem::path parent = file.parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
-  auto out = OIIO::ImageOutput::create(file.string());
-  if (!out)
+  std::string tmpl = (parent.empty() ? std::filesystem::path(".") : parent).string() + "/." +
+                     file.filename().string() + ".tmp-XXXXXX" + file.extension().string();
+  std::vector<char> name(tmpl.begin(), tmpl.end());
+  name.push_back('\0');
+  int fd = ::mkstemps(name.data(), int(file.extension().string().size()));
+  if (fd < 0)
+    throw std::runtime_error(fmt::format("{}: cannot create a temporary file ({})", file.string(),
+                                         std::strerror(errno)));
+  const std::string tmp(name.data());
+  TempFileGuard guard(tmp);
+  // The plugin is chosen by the extension, which the temporary shares with the destination.
+  auto out = OIIO::ImageOutput::create(tmp);
+  if (!out) {
+    ::close(fd);
     throw std::runtime_error(fmt::format("{}: cannot write ({})", file.string(), OIIO::geterror()));
-  if (!out->open(file.string(), spec) || !out->write_image(type, data) || !out->close())
+  }
+  ::fchmod(fd,
+           0644 & ~current_umask()); // mkstemp creates 0600; an image is as readable as any file
+  if (!out->open(tmp, spec) || !out->write_image(type, data) || !out->close()) {
+    ::close(fd);
     throw std::runtime_error(fmt::format("{}: cannot write ({})", file.string(), out->geterror()));
+  }
+  // The data reaches the disk before the name points at it.
+  ::fsync(fd);
+  ::close(fd);
+  if (::rename(tmp.c_str(), file.c_str()) != 0)
+    throw std::runtime_error(
+        fmt::format("{}: cannot write (rename: {})", file.string(), std::strerror(errno)));
+  guard.commit();
 }
 
 } // namespace

@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include "render/camera.h"
+#include "render/memory_budget.h"
 
 #include <fmt/format.h>
 
@@ -163,6 +164,16 @@ Film Renderer::render(const RenderSettings& settings) {
   const size_t W = size_t(std::min<uint64_t>(total, wave));
   const size_t split_cap = W * sampler_.max_cut;
   const int max_depth = scene_.integrator.max_depth;
+  // Fail before any work if the film or the wave does not fit (docs/limits.md).
+  check_memory(rt_.device(),
+               {{"film_sum", uint64_t(npix) * sizeof(float4)},
+                {"film_sumsq", uint64_t(npix) * sizeof(float4)},
+                {"film_counts", uint64_t(npix) * sizeof(float2)},
+                {"shadow_stage", 4 * uint64_t(split_cap) * sizeof(ShadowItem)},
+                {"child_stage", 4 * uint64_t(split_cap) * sizeof(SplitItem)}},
+               {{"film (host copy)", uint64_t(npix) * (2 * sizeof(float4) + sizeof(float2))},
+                {"image", uint64_t(npix) * 3 * sizeof(float)}},
+               printable(scene_.path.string(), 1024));
 
   // Path state (struct of arrays) and queues, sized for one wave.
   cl::Buffer ray_o = device_buffer(ctx, W * sizeof(float4));

@@ -15,6 +15,9 @@ void throw_error(const std::string& file, const std::string& path, std::string_v
 
 namespace {
 
+// Keys are echoed in JSON paths; a longer key is cut with an ellipsis.
+constexpr size_t kMaxKeyChars = 64;
+
 // Tracks the JSON path during parsing so a duplicate key (which nlohmann would silently resolve to
 // the last value) is reported as "<file>: <path>.<key>: duplicate key".
 class DuplicateKeyCheck {
@@ -34,6 +37,7 @@ public:
       Frame& f = frames_.back();
       f.key = parsed.get<std::string>();
       if (!f.keys.insert(f.key).second) throw_error(file_, path(), "duplicate key");
+      f.key = printable(f.key, kMaxKeyChars);
       break;
     }
     case E::object_end:
@@ -243,7 +247,7 @@ std::string JsonValue::as_enum(std::initializer_list<std::string_view> allowed) 
     if (!list.empty()) list += ", ";
     list += a;
   }
-  fail(fmt::format("unknown value \"{}\" (expected one of: {})", s, list));
+  fail(fmt::format("unknown value \"{}\" (expected one of: {})", printable(s), list));
 }
 
 float3 JsonValue::as_vec3() const {
@@ -274,9 +278,8 @@ float3 JsonValue::as_color() const {
 }
 
 float3 JsonValue::as_emission() const {
-  float3 c = as_color();
-  if (!(c.x > 0.0f || c.y > 0.0f || c.z > 0.0f)) fail("must be > 0");
-  return c;
+  // Zero is allowed: a light switched off, skipped by the loader.
+  return as_color();
 }
 
 float3 JsonValue::as_albedo() const {
@@ -321,8 +324,9 @@ JsonObject::JsonObject(const JsonValue& v) : v_(v) {
 }
 
 std::string JsonObject::child_path(std::string_view key) const {
-  if (v_.path().empty()) return std::string(key);
-  return fmt::format("{}.{}", v_.path(), key);
+  std::string k = printable(key, kMaxKeyChars);
+  if (v_.path().empty()) return k;
+  return fmt::format("{}.{}", v_.path(), k);
 }
 
 void JsonObject::allow(std::initializer_list<std::string_view> keys) const {

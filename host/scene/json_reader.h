@@ -59,7 +59,7 @@ public:
   float3 as_vec3_nonzero() const;
   // Colours: a number (grey) or an array of 3 numbers, every component >= 0.
   float3 as_color() const;
-  // Colour that must not be black (an emitter): components >= 0, at least one > 0.
+  // An emission: components >= 0; black means switched off (the loader skips such a light).
   float3 as_emission() const;
   // Reflectance: components in [0, 1].
   float3 as_albedo() const;

@@ -61,7 +61,8 @@ void expand_light_set(const JsonValue& v, Builder& b) {
   std::optional<ShapeDesc> inst;
   if (auto iv = o.get("instance")) inst = parse_shape(*iv, b);
 
-  auto count_of = [&](const char* key) { return o.req(key).as_int(1, kMaxLights); };
+  // A count of 0 is accepted (a set switched off); nx and ny, when given, are >= 1.
+  auto count_of = [&](const char* key) { return o.req(key).as_int(0, kMaxLights); };
 
   std::vector<float3> sites;
   std::vector<float3> normals; // mesh_surface only
@@ -82,7 +83,7 @@ void expand_light_set(const JsonValue& v, Builder& b) {
       if (count > kMaxLights) o.req("ny").fail(fmt::format("nx * ny must be <= {}", kMaxLights));
     } else {
       count = count_of("count");
-      nx = int64_t(std::ceil(std::sqrt(double(count))));
+      nx = std::max<int64_t>(1, int64_t(std::ceil(std::sqrt(double(count)))));
       ny = (count + nx - 1) / nx;
     }
     sites.reserve(size_t(count));
@@ -143,7 +144,8 @@ void expand_light_set(const JsonValue& v, Builder& b) {
       std::string name = sv.as_string();
       for (const auto& r : b.shapes)
         if (r.name == name) range = &r;
-      if (!range) sv.fail(fmt::format("no shape named \"{}\" (shapes are matched by name)", name));
+      if (!range)
+        sv.fail(fmt::format("no shape named \"{}\" (shapes are matched by name)", printable(name)));
     } else {
       if (b.shapes.empty()) sv.fail("there are no shapes to refer to");
       int64_t k = sv.as_int(0, int64_t(b.shapes.size()) - 1);
@@ -209,19 +211,24 @@ void expand_light_set(const JsonValue& v, Builder& b) {
       l.emission.y *= s * cg;
       l.emission.z *= s * cb;
     }
-    lights.push_back(l);
+    // A site far outside float range would make positions infinite; positions beyond
+    // kMaxCoordinate would overflow the renderer's squared distances and bounds.
+    if (!std::isfinite(l.emission.x) || !std::isfinite(l.emission.y) ||
+        !std::isfinite(l.emission.z))
+      v.fail(fmt::format("light {} (of {}) has a non-finite emission", i + 1, n));
+    if (auto e = check_light_extent(l); !e.empty())
+      v.fail(fmt::format("light {} (of {}): {}", i + 1, n, e));
+    if (emits(l))
+      lights.push_back(l);
+    else
+      ++b.scene.skipped_lights;
   }
   if (inst) {
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i = 0; i < n; ++i) {
+      size_t first_vertex = b.scene.vertices.size();
       b.add_mesh(inst->mesh, inst->transform.then(Transform::translate(sites[i])));
-  }
-  // A site far outside float range would make positions infinite.
-  for (size_t i = lights.size() - n; i < lights.size(); ++i) {
-    const Light& l = lights[i];
-    if (!std::isfinite(l.p.x) || !std::isfinite(l.p.y) || !std::isfinite(l.p.z) ||
-        !std::isfinite(l.emission.x) || !std::isfinite(l.emission.y) ||
-        !std::isfinite(l.emission.z))
-      v.fail("generates a light with a non-finite position or emission");
+      check_vertices(b.scene, first_vertex, v, fmt::format("instance {} (of {}): ", i + 1, n));
+    }
   }
 }
 

@@ -111,6 +111,25 @@ Transform parse_transform(const JsonValue& v);
 Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b,
               int material_override);
 
+// Input guards (input_guard.cpp).
+// The whole content of a regular file of at most `max_bytes`; anything else (missing, a
+// directory, FIFO, device, socket, too large) is a SceneError "<prefix>cannot open file (...)".
+// `prefix` is the message start, e.g. "scene.json: " or "scene.json: shapes[0].file: a.obj: ".
+std::string read_input_file(const std::filesystem::path& file, uint64_t max_bytes,
+                            const std::string& prefix);
+// Empty if every component of p is within kMaxCoordinate, else the problem (for a message).
+std::string check_coordinate(float3 p);
+// Same for the extent of a light (position, corners, or sphere bounds), "its position [...] is
+// outside ...".
+std::string check_light_extent(const Light& l);
+
+// Fails at `at` if a vertex of s.vertices[first_vertex..] is outside the coordinate range;
+// `what` starts the problem text (e.g. "instance 3: ").
+void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,
+                    std::string_view what);
+// True if the light has a non-zero emission.
+bool emits(const Light& l);
+
 // Lights (lights.cpp).
 // An analytic light from a JSON object. As a template of a light set, position-like keys are
 // offsets from the generated site and may be omitted (quad/triangle are then centred on the site).

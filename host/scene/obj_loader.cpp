@@ -5,19 +5,74 @@
 #include <fmt/format.h>
 #include <tiny_obj_loader.h>
 
+#include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <sstream>
 
 namespace canopy::detail {
 
 namespace {
 
-// tinyobjloader only warns about a missing material library; the scene format makes it an error,
-// so the mtllib lines are checked first.
-void check_mtllibs(const std::filesystem::path& obj, const std::string& obj_name,
-                   const JsonValue& at) {
-  std::ifstream in(obj);
+// tinyobjloader reads a missing or unparsable number as 0 ("v 1" is the vertex (1, 0, 0), "v nan 0
+// 0" the origin) and triangulates a polygon in time quadratic in its vertex count. The text is
+// therefore checked first, line by line: every number of a v / vn / vt line must parse completely
+// and be finite, a v line needs at least 3 numbers, vn 3 and vt 1, and a face has at most
+// kMaxPolygonVertices vertices. A scan is simpler and cheaper than a second parser, and it knows
+// the line number for the message.
+void check_obj_text(const std::string& text, const std::string& prefix) {
+  size_t line_no = 0;
+  std::vector<std::string_view> tok;
+  for (size_t pos = 0; pos < text.size();) {
+    size_t eol = text.find('\n', pos);
+    if (eol == std::string::npos) eol = text.size();
+    std::string_view line(text.data() + pos, eol - pos);
+    pos = eol + 1;
+    ++line_no;
+    if (auto h = line.find('#'); h != std::string_view::npos) line = line.substr(0, h);
+    tok.clear();
+    for (size_t i = 0; i < line.size();) {
+      while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r'))
+        ++i;
+      size_t j = i;
+      while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r')
+        ++j;
+      if (j > i) tok.push_back(line.substr(i, j - i));
+      i = j;
+    }
+    if (tok.empty()) continue;
+    auto fail = [&](const std::string& problem) {
+      throw SceneError(fmt::format("{}line {}: {}", prefix, line_no, problem));
+    };
+    if (tok[0] == "f") {
+      if (tok.size() - 1 > size_t(kMaxPolygonVertices))
+        fail(fmt::format("a face with {} vertices (the limit is {}, docs/limits.md)",
+                         tok.size() - 1, kMaxPolygonVertices));
+      continue;
+    }
+    size_t need = tok[0] == "v" ? 3 : tok[0] == "vn" ? 3 : tok[0] == "vt" ? 1 : 0;
+    if (need == 0) continue;
+    if (tok.size() - 1 < need)
+      fail(fmt::format("'{}' needs {} numbers, found {}", tok[0], need, tok.size() - 1));
+    for (size_t k = 1; k < tok.size(); ++k) {
+      std::string_view t = tok[k];
+      if (t.size() > 1 && t[0] == '+' && t[1] != '-') t.remove_prefix(1); // from_chars: no '+'
+      double d = 0.0;
+      auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), d);
+      if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(d) ||
+          std::fabs(d) > double(std::numeric_limits<float>::max()))
+        fail(fmt::format("'{}': '{}' is not a finite number", tok[0], printable(tok[k], 40)));
+    }
+  }
+}
+
+// Every existing material library named by an mtllib line must be a regular file under the size
+// limit; tinyobjloader only warns about a missing one, and the scene format makes that an error.
+void check_mtllibs(const std::string& text, const std::filesystem::path& dir,
+                   const std::string& prefix) {
+  std::istringstream in(text);
   std::string line;
   while (std::getline(in, line)) {
     size_t i = line.find_first_not_of(" \t");
@@ -31,13 +86,39 @@ void check_mtllibs(const std::filesystem::path& obj, const std::string& obj_name
       if (!any) first = n;
       any = true;
       std::error_code ec;
-      if (std::filesystem::is_regular_file(obj.parent_path() / n, ec)) found = true;
+      if (std::filesystem::exists(dir / n, ec)) found = true;
     }
     if (any && !found)
-      at.fail(fmt::format("{}: cannot open material library '{}'", obj_name,
-                          (obj.parent_path() / first).string()));
+      throw SceneError(fmt::format("{}cannot open material library '{}'", prefix,
+                                   printable((dir / first).string(), 256)));
   }
 }
+
+// Reads MTL files through read_input_file (regular files under the size limit only).
+class CheckedMaterialReader : public tinyobj::MaterialReader {
+public:
+  CheckedMaterialReader(std::filesystem::path dir, std::string prefix)
+      : dir_(std::move(dir)), prefix_(std::move(prefix)) {}
+  bool operator()(const std::string& mat_id, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* mat_map, std::string* warn,
+                  std::string* err) override {
+    std::filesystem::path p = dir_ / mat_id;
+    std::error_code ec;
+    if (!std::filesystem::exists(p, ec)) {
+      if (warn) *warn += "Material file [ " + mat_id + " ] not found\n";
+      return false;
+    }
+    std::string text = read_input_file(p, kMaxMtlFileBytes,
+                                       fmt::format("{}{}: ", prefix_, printable(mat_id, 256)));
+    std::istringstream in(text);
+    tinyobj::LoadMtl(mat_map, materials, &in, warn, err);
+    return true;
+  }
+
+private:
+  std::filesystem::path dir_;
+  std::string prefix_;
+};
 
 bool finite_nonneg3(const tinyobj::real_t* c) {
   for (int i = 0; i < 3; ++i)
@@ -49,25 +130,25 @@ bool finite_nonneg3(const tinyobj::real_t* c) {
 
 Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b,
               int material_override) {
-  std::string name = at.as_string();
+  std::string name = printable(at.as_string(), 256);
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    at.fail(fmt::format("cannot open OBJ file '{}'", file.string()));
-  {
-    std::ifstream probe(file);
-    if (!probe) at.fail(fmt::format("cannot open OBJ file '{}'", file.string()));
-  }
-  check_mtllibs(file, name, at);
+  if (!std::filesystem::exists(file, ec))
+    at.fail(fmt::format("cannot open OBJ file '{}'", printable(file.string(), 1024)));
+  const std::string prefix = fmt::format("{}: {}: {}: ", at.file(), at.path(), name);
+  const std::string text = read_input_file(file, kMaxObjFileBytes, prefix);
+  std::filesystem::path dir = file.parent_path();
+  if (dir.empty()) dir = std::filesystem::path(".");
+  check_mtllibs(text, dir, prefix);
+  check_obj_text(text, prefix);
 
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
-  std::filesystem::path dir = file.parent_path();
-  if (dir.empty()) dir = std::filesystem::path(".");
-  const std::string mtl_dir = dir.string();
-  bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, file.string().c_str(),
-                             mtl_dir.c_str(), /*triangulate=*/true);
+  std::istringstream in(text);
+  CheckedMaterialReader mtl_reader(dir, prefix);
+  bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, &mtl_reader,
+                             /*triangulate=*/true);
   auto first_line = [](std::string_view s) { return s.substr(0, s.find('\n')); };
   if (!ok || !err.empty()) at.fail(fmt::format("{}: {}", name, first_line(err)));
   if (auto p = warn.find("material ["); p != std::string::npos)
@@ -91,9 +172,9 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     const auto& mt = materials[i];
     for (int c = 0; c < 3; ++c)
       if (!std::isfinite(mt.diffuse[c]) || mt.diffuse[c] < 0 || mt.diffuse[c] > 1)
-        at.fail(fmt::format("{}: material '{}': Kd must be in [0, 1]", name, mt.name));
+        at.fail(fmt::format("{}: material '{}': Kd must be in [0, 1]", name, printable(mt.name)));
     if (!finite_nonneg3(mt.emission))
-      at.fail(fmt::format("{}: material '{}': Ke must be >= 0", name, mt.name));
+      at.fail(fmt::format("{}: material '{}': Ke must be >= 0", name, printable(mt.name)));
     mat_emission[i] = make_float3(mt.emission[0], mt.emission[1], mt.emission[2]);
     if (material_override < 0)
       mat_index[i] =
@@ -108,13 +189,13 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     for (size_t f = 0; f < nf; ++f) {
       if (mesh.num_face_vertices[f] != 3)
         at.fail(fmt::format("{}: face {} of '{}' is not a triangle after triangulation", name,
-                            f + 1, sh.name));
+                            f + 1, printable(sh.name)));
       uint32_t idx[3];
       for (int k = 0; k < 3; ++k) {
         int vi = mesh.indices[3 * f + k].vertex_index;
         if (vi < 0 || size_t(vi) >= nv)
           at.fail(fmt::format("{}: face {} of '{}' has a vertex index out of range", name, f + 1,
-                              sh.name));
+                              printable(sh.name)));
         idx[k] = uint32_t(vi);
       }
       int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;

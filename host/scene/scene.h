@@ -9,16 +9,36 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace canopy {
 
+// Numeric and resource limits of the scene format; docs/limits.md says why each exists.
+// Every vertex and light, after transforms and light-set generation, lies in [-kMaxCoordinate,
+// kMaxCoordinate]^3: then differences (< 2e18), squared distances (< 1.2e37) and cross products
+// of edges stay finite in float, with 10 decades of headroom below FLT_MAX (3.4e38).
+inline constexpr float kMaxCoordinate = 1e18f;
+inline constexpr uint64_t kMaxSceneFileBytes = uint64_t(256) << 20; // 256 MiB
+inline constexpr uint64_t kMaxObjFileBytes = uint64_t(2) << 30;     // 2 GiB
+inline constexpr uint64_t kMaxMtlFileBytes = uint64_t(64) << 20;    // 64 MiB
+inline constexpr int kMaxPolygonVertices = 1024;                    // vertices of one OBJ face
+inline constexpr int kMaxSpp = 1 << 24;
+inline constexpr int kMaxFilmSide = 16384;
+
+// `s` made safe to echo inside a one-line message: control characters (including NUL and C1
+// controls), invalid UTF-8 and the Unicode line/paragraph separators become \n, \t, \xHH or
+// \uHHHH escapes, and a string longer than `max_chars` code points is cut with an ellipsis.
+std::string printable(std::string_view s, size_t max_chars = 100);
+
 // Thrown for any invalid input. what() is the complete one-line message, formatted as
 // "<file>: <json path>: <problem>", e.g. "scene.json: lights[3].radius: must be > 0".
-// The CLI prints it and exits with code 2.
+// The CLI prints it and exits with code 2. The message is passed through printable() (without a
+// length limit), so whatever user text it quotes, it stays one line.
 class SceneError : public std::runtime_error {
 public:
-  using std::runtime_error::runtime_error;
+  explicit SceneError(const std::string& message)
+      : std::runtime_error(printable(message, std::string::npos)) {}
 };
 
 struct Camera {
@@ -29,12 +49,12 @@ struct Camera {
 };
 
 struct FilmSettings {
-  int width = 640;  // pixels, 1 .. 16384
-  int height = 480; // pixels, 1 .. 16384
+  int width = 640;  // pixels, 1 .. kMaxFilmSide
+  int height = 480; // pixels, 1 .. kMaxFilmSide
 };
 
 struct IntegratorSettings {
-  int spp = 16;      // samples per pixel, >= 1
+  int spp = 16;      // samples per pixel, 1 .. kMaxSpp
   int max_depth = 1; // path vertices after the camera hit: 1 = direct light only
   std::string light_sampler = "uniform"; // uniform | power | tree | tree-split | exhaustive
   float split_threshold = 0.85f;         // adaptive splitting threshold in [0, 1]
@@ -60,7 +80,8 @@ struct Scene {
   std::vector<uint32_t> indices;          // 3 per triangle
   std::vector<int32_t> triangle_material; // per triangle
   std::vector<int32_t> triangle_light;    // per triangle, -1 if not emissive
-  std::vector<Light> lights;
+  std::vector<Light> lights; // only lights that emit (zero-emission lights are skipped)
+  size_t skipped_lights = 0; // lights given with zero emission, not in `lights`
 
   size_t triangle_count() const { return indices.size() / 3; }
 };

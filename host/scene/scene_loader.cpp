@@ -58,7 +58,7 @@ Transform Transform::rotate(float3 a, float degrees) {
 int Builder::material_ref(const JsonValue& v) const {
   std::string name = v.as_string();
   auto it = material_by_name.find(name);
-  if (it == material_by_name.end()) v.fail(fmt::format("unknown material \"{}\"", name));
+  if (it == material_by_name.end()) v.fail(fmt::format("unknown material \"{}\"", printable(name)));
   return it->second;
 }
 
@@ -129,6 +129,17 @@ size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
   return first_tri;
 }
 
+void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,
+                    std::string_view what) {
+  for (size_t i = first_vertex; i < s.vertices.size(); ++i)
+    if (auto e = check_coordinate(s.vertices[i]); !e.empty())
+      at.fail(fmt::format("{}vertex {} after the transform: {}", what, i - first_vertex + 1, e));
+}
+
+bool emits(const Light& l) {
+  return l.emission.x > 0.0f || l.emission.y > 0.0f || l.emission.z > 0.0f;
+}
+
 // ------------------------------------------------------------------------------ top-level parts
 
 namespace {
@@ -136,9 +147,12 @@ namespace {
 void parse_camera(const JsonValue& v, Camera& cam) {
   auto o = v.as_object();
   o.allow({"position", "look_at", "up", "fov"});
-  cam.position = o.req("position").as_vec3();
+  auto pos = o.req("position");
+  cam.position = pos.as_vec3();
+  if (auto e = check_coordinate(cam.position); !e.empty()) pos.fail(e);
   auto look = o.req("look_at");
   cam.look_at = look.as_vec3();
+  if (auto e = check_coordinate(cam.look_at); !e.empty()) look.fail(e);
   float3 dir = cam.look_at - cam.position;
   if (dir.x == 0.0f && dir.y == 0.0f && dir.z == 0.0f)
     look.fail("must differ from camera.position");
@@ -161,14 +175,14 @@ void parse_camera(const JsonValue& v, Camera& cam) {
 void parse_film(const JsonValue& v, FilmSettings& film) {
   auto o = v.as_object();
   o.allow({"width", "height"});
-  if (auto w = o.get("width")) film.width = int(w->as_int(1, 16384));
-  if (auto h = o.get("height")) film.height = int(h->as_int(1, 16384));
+  if (auto w = o.get("width")) film.width = int(w->as_int(1, kMaxFilmSide));
+  if (auto h = o.get("height")) film.height = int(h->as_int(1, kMaxFilmSide));
 }
 
 void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
   auto o = v.as_object();
   o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "seed"});
-  if (auto x = o.get("spp")) in.spp = int(x->as_int(1, 1 << 24));
+  if (auto x = o.get("spp")) in.spp = int(x->as_int(1, kMaxSpp));
   if (auto x = o.get("max_depth")) in.max_depth = int(x->as_int(1, 1024));
   if (auto x = o.get("light_sampler"))
     in.light_sampler = x->as_enum({"uniform", "power", "tree", "tree-split", "exhaustive"});
@@ -198,7 +212,7 @@ void parse_materials(const JsonValue& v, Builder& b) {
       continue;
     }
     if (b.material_by_name.count(name))
-      nv.fail(fmt::format("duplicate material name \"{}\"", name));
+      nv.fail(fmt::format("duplicate material name \"{}\"", printable(name)));
     b.material_by_name[name] = int(s.materials.size());
     s.materials.push_back(d);
   }
@@ -210,8 +224,11 @@ void parse_shapes(const JsonValue& v, Builder& b) {
     if (!d.name.empty())
       for (const auto& r : b.shapes)
         if (r.name == d.name)
-          sv.as_object().req("name").fail(fmt::format("duplicate shape name \"{}\"", d.name));
+          sv.as_object().req("name").fail(
+              fmt::format("duplicate shape name \"{}\"", printable(d.name)));
+    size_t first_vertex = b.scene.vertices.size();
     size_t first = b.add_mesh(d.mesh, d.transform);
+    check_vertices(b.scene, first_vertex, sv, "");
     b.shapes.push_back({d.name, first, b.scene.triangle_count()});
   }
 }
@@ -248,16 +265,22 @@ Scene load_from_string(const std::string& json_text, const std::string& name,
   if (auto x = o.get("lights")) {
     size_t n = x->array_size();
     scene.lights.reserve(scene.lights.size() + n);
-    for (size_t i = 0; i < n; ++i)
-      scene.lights.push_back(parse_light(x->at(i), false));
+    for (size_t i = 0; i < n; ++i) {
+      JsonValue lv = x->at(i);
+      Light l = parse_light(lv, false);
+      if (auto e = check_light_extent(l); !e.empty()) lv.fail(e);
+      // A light switched off (zero emission) is skipped: it neither emits nor occludes.
+      if (emits(l))
+        scene.lights.push_back(l);
+      else
+        ++scene.skipped_lights;
+    }
   }
   if (auto x = o.get("light_sets")) {
     for (const JsonValue& sv : x->as_array())
       expand_light_set(sv, b);
   }
-  if (scene.lights.empty())
-    throw_error(name, "lights",
-                "the scene has no emitters (add lights, light_sets or an emissive shape)");
+  // A scene without emitters is valid: it renders black (the CLI warns).
   return scene;
 }
 
@@ -275,16 +298,9 @@ Scene load_scene_from_string(const std::string& json_text, const std::string& na
 }
 
 Scene load_scene(const std::filesystem::path& file) {
-  std::string name = file.string();
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec))
-    throw SceneError(fmt::format("{}: cannot open file (it is a directory)", name));
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError(fmt::format("{}: cannot open file", name));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw SceneError(fmt::format("{}: cannot read file", name));
-  Scene s = load_scene_from_string(ss.str(), name, file.parent_path());
+  std::string name = printable(file.string(), 1024);
+  std::string text = detail::read_input_file(file, kMaxSceneFileBytes, name + ": ");
+  Scene s = load_scene_from_string(text, name, file.parent_path());
   s.path = file;
   return s;
 }

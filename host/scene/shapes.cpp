@@ -31,7 +31,8 @@ Transform parse_transform(const JsonValue& v) {
     xf = xf.then(Transform::rotate(normalize(axis), deg));
   }
   if (auto t = o.get("translate")) xf = xf.then(Transform::translate(t->as_vec3()));
-  if (!std::isfinite(xf.det()) || xf.det() == 0.0f) v.fail("is degenerate (zero determinant)");
+  if (!std::isfinite(xf.det())) v.fail("is too large (its determinant overflows; docs/limits.md)");
+  if (xf.det() == 0.0f) v.fail("is degenerate (zero determinant)");
   return xf;
 }
 
