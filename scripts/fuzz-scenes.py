@@ -492,12 +492,43 @@ def m_counts(rng, tree, m):
     return True
 
 
+def m_extent(rng, tree, m):
+    """Extents that are finite but whose derived values overflow: a box from -X to +X, a
+    transform scale of X, a light-set origin or edge of X (X near the float maximum)."""
+    x = rng.choice([1e30, 1e37, 1e38, 3e38, 3.4e38])
+    objs = [p for p, i, _ in slots(tree) if isinstance(p, Obj) and i == 0]
+    boxes = [o for o in objs if member(o, "min") is not None and member(o, "max") is not None]
+    shapes = [o for o in objs if member(o, "type") in ("box", "quad", "obj")]
+    sets = [o for o in objs if member(o, "origin") is not None or member(o, "center") is not None]
+    c = rng.randrange(3)
+    if c == 0 and boxes:
+        o = rng.choice(boxes)
+        set_member(o, "min", [-x, -x, -x] if rng.random() < 0.5 else [-x, 0, -x])
+        set_member(o, "max", [x, x, x])
+        m.ops.append(f"extent: box from -{x:g} to {x:g}")
+    elif c == 1 and shapes:
+        o = rng.choice(shapes)
+        set_member(o, "transform", Obj([["scale", x if rng.random() < 0.5 else [x, 1, 1]]]))
+        m.ops.append(f"extent: transform scale {x:g}")
+    elif sets:
+        o = rng.choice(sets)
+        key = "origin" if member(o, "origin") is not None else "center"
+        set_member(o, key, [x, x, -x])
+        if member(o, "edge1") is not None:
+            set_member(o, "edge1", [x, 0, 0])
+        m.ops.append(f"extent: {key} ({x:g}, {x:g}, {-x:g})")
+    else:
+        return False
+    return True
+
+
 TREE_OPS = {
     "key-rename": (m_key_rename, 4), "key-delete": (m_key_delete, 5),
     "key-duplicate": (m_key_duplicate, 4), "key-weird": (m_key_weird, 4),
     "string": (m_string, 6), "type": (m_type, 8), "number": (m_number, 14),
     "vector": (m_vector, 5), "array": (m_array, 4), "translate": (m_translate, 4),
     "scale": (m_scale, 2), "emission": (m_emission, 3), "count": (m_counts, 3),
+    "extent": (m_extent, 4),
 }
 
 
@@ -1016,14 +1047,22 @@ def run_one(m, args, work, failures):
             # The kernel enforces the limit on the process itself: /dev/zero read without bound
             # ends in bad_alloc instead of exhausting the machine.
             run = ["/bin/sh", "-c", f'ulimit -v {args.mem_limit_mb * 1024} && exec "$@"', "sh"] + cmd
-        p = subprocess.Popen(run, cwd=wdir, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, start_new_session=True)
-        try:
-            out, err = p.communicate(timeout=args.timeout)
-        except subprocess.TimeoutExpired:
-            timed_out = True
-            os.killpg(p.pid, signal.SIGKILL)
-            out, err = p.communicate()
+        # A render that times out is run once more with three times the timeout, so a slow
+        # render on a busy machine is not mistaken for a hang.
+        for limit in (args.timeout, 3 * args.timeout):
+            if (wdir / "out.exr").exists():
+                (wdir / "out.exr").unlink()
+            p = subprocess.Popen(run, cwd=wdir, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, start_new_session=True)
+            try:
+                out, err = p.communicate(timeout=limit)
+                timed_out = False
+            except subprocess.TimeoutExpired:
+                timed_out = True
+                os.killpg(p.pid, signal.SIGKILL)
+                out, err = p.communicate()
+            if not timed_out:
+                break
         rc = p.returncode
         passed, cls, detail = classify(m, rc, timed_out, out, err, wdir, args.iinfo)
     except Exception:  # a failure of the fuzzer itself is a failure too
@@ -1125,7 +1164,8 @@ def main():
     ap.add_argument("--count", type=int, default=1000, help="number of mutants (default 1000)")
     ap.add_argument("--jobs", type=int, default=2, help="renders in parallel")
     ap.add_argument("--seed", type=int, default=1, help="fuzzer seed (the mutants depend on it)")
-    ap.add_argument("--timeout", type=float, default=20.0, help="seconds per render")
+    ap.add_argument("--timeout", type=float, default=20.0,
+                    help="seconds per render (a timed-out render is retried with 3x this)")
     ap.add_argument("--mem-limit-mb", type=int, default=4096,
                     help="address-space limit per render (0: none; must be 0 under ASan)")
     ap.add_argument("--out", default="fuzz-out", help="output directory (failures/, results.jsonl)")
