@@ -254,7 +254,7 @@ TEST_F(KernelLightPicks, TreeMillionLightsTwelveDecades) {
          {},
          make_float3(3, -2, 0),
          make_float3(0, 0, 1),
-         4000000,
+         2000000,
          14};
   c.group.assign(c.lights.size(), 0);
   check(rt, c);
