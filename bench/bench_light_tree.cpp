@@ -6,16 +6,28 @@
 //   TreeSplitPick/<N>/<layout>   the same with adaptive splitting (threshold 0.85, max_cut 64);
 //                                counters points_per_second, avg_cut
 //   SplitCut/<threshold*100>     spiral scene of the paper's Fig. 11 (10^4 lights): mean cut size
+//   PickCpu/<N>/<sampler>        one light_sampler_pick (the device function) per random shading
+//                                point on the host, one thread; counter cpu_ns_per_pick (thread CPU
+//                                time, less sensitive to other load than wall time)
+//   DevicePick/<N>/<sampler>     the same picks in an OpenCL kernel (PoCL); counter
+//                                cpu_ns_per_pick = process CPU time (all device threads) per pick
+// sampler: 0 uniform, 1 power, 2 tree (random points layout).
 // layout: 0 random points, 1 randomly oriented triangles, 2 city-like layout.
+#include "cl/runtime.h"
 #include "lighttree/light_sampler.h"
 #include "lighttree/synthetic_lights.h"
+#include "render/device_scene.h"
+#include "render/light_sampler_data.h"
 
 #include <benchmark/benchmark.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <sys/resource.h>
+
 #include <atomic>
+#include <ctime>
 #include <map>
 #include <mutex>
 
@@ -150,6 +162,125 @@ void BM_SplitCut(benchmark::State& state) {
   state.counters["avg_cut"] = cut / kPoints;
 }
 
+double thread_cpu_seconds() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+double process_cpu_seconds() {
+  rusage u;
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+const char* kSamplerByIndex[3] = {"uniform", "power", "tree"};
+
+void BM_PickCpu(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const std::vector<Light>& lights = lights_for(n, 0);
+  LightSamplerData data = make_light_sampler_data(lights, kSamplerByIndex[state.range(1)], 0.0f, 1);
+  LightSamplerCtx ls = data.host_view(lights);
+  const int kPoints = 4096, kPicks = 100000;
+  std::vector<Shading> pts = shading_points(lights, 0, kPoints);
+  double cpu = 0;
+  long long picks = 0, sink = 0;
+  uint32_t round = 0;
+  for (auto _ : state) {
+    ++round;
+    double t0 = thread_cpu_seconds();
+    for (int k = 0; k < kPicks; ++k) {
+      LtRng rng = lt_rng_make(round, uint32_t(k));
+      float pmf;
+      const Shading& x = pts[size_t(k) & (kPoints - 1)];
+      sink += light_sampler_pick(&ls, 0, x.P, x.N, &rng, &pmf) + (pmf > 0.5f);
+    }
+    cpu += thread_cpu_seconds() - t0;
+    picks += kPicks;
+  }
+  benchmark::DoNotOptimize(sink);
+  state.SetLabel(kSamplerByIndex[state.range(1)]);
+  state.counters["cpu_ns_per_pick"] = 1e9 * cpu / double(picks);
+}
+
+const char* kDevicePickKernel = R"CL(
+#include "kernels/params.h"
+__kernel void pick_bench(LIGHT_SAMPLER_PARAMS, __global const float4* P, __global const float4* N,
+                         uint seed, int count, __global int* out) {
+  int i = get_global_id(0);
+  if (i >= count) return;
+  LIGHT_SAMPLER_ASSEMBLE(ls);
+  LtRng rng = lt_rng_make(seed, (uint)i);
+  float pmf;
+  int l = light_sampler_pick(&ls, 0, xyz_of(P[i & 4095]), xyz_of(N[i & 4095]), &rng, &pmf);
+  out[i] = l + (pmf > 0.5f);
+}
+)CL";
+
+void BM_DevicePick(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const std::vector<Light>& lights = lights_for(n, 0);
+  LightSamplerData data = make_light_sampler_data(lights, kSamplerByIndex[state.range(1)], 0.0f, 1);
+  const int kPoints = 4096, kPicks = 1 << 20;
+  std::vector<Shading> pts = shading_points(lights, 0, kPoints);
+  std::vector<float4> P(kPoints), N(kPoints);
+  for (int i = 0; i < kPoints; ++i) {
+    P[i] = f4_from3(pts[i].P, 0.0f);
+    N[i] = f4_from3(pts[i].N, 0.0f);
+  }
+  ClRuntime rt;
+  cl::Program program(rt.context(), kDevicePickKernel);
+  std::string opts = "-I " + kernel_dir().string() +
+                     " -cl-std=CL1.2 -DCANOPY_LIGHT_SAMPLER=" + std::to_string(data.kind);
+  program.build({rt.device()}, opts.c_str());
+  const cl::Context& ctx = rt.context();
+  DeviceScene d;
+  d.lights = upload_buffer(ctx, lights);
+  d.power_pmf = upload_buffer(ctx, data.power_pmf);
+  d.alias_prob = upload_buffer(ctx, data.alias_prob);
+  d.alias_index = upload_buffer(ctx, data.alias_index);
+  d.lt_nodes = upload_buffer(ctx, data.tree.nodes);
+  d.lt_children = upload_buffer(ctx, data.tree.children);
+  d.lt_leaf_lights = upload_buffer(ctx, data.tree.leaf_lights);
+  d.lt_trails = upload_buffer(ctx, data.tree.trails);
+  d.light_count = n;
+  d.root_sphere = data.tree.root_sphere;
+  d.root_info = data.tree.root_info;
+  d.max_cut = data.root_budget();
+  cl::Buffer bp = upload_buffer(ctx, P), bn = upload_buffer(ctx, N);
+  cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, sizeof(int) * kPicks);
+  cl::Kernel k(program, "pick_bench");
+  int a = d.set_light_sampler_args(k, 0);
+  k.setArg(a++, bp);
+  k.setArg(a++, bn);
+  const int seed_arg = a++;
+  k.setArg(a++, cl_int(kPicks));
+  k.setArg(a++, out);
+  k.setArg(seed_arg, cl_uint(0));
+  enqueue_1d(rt.queue(), k, kPicks); // warm-up (and PoCL's work-group compile)
+  rt.queue().finish();
+  double cpu = 0;
+  long long picks = 0;
+  uint32_t round = 0;
+  for (auto _ : state) {
+    k.setArg(seed_arg, cl_uint(++round));
+    double t0 = process_cpu_seconds();
+    enqueue_1d(rt.queue(), k, kPicks);
+    rt.queue().finish();
+    cpu += process_cpu_seconds() - t0;
+    picks += kPicks;
+  }
+  state.SetLabel(kSamplerByIndex[state.range(1)]);
+  state.counters["cpu_ns_per_pick"] = 1e9 * cpu / double(picks);
+  state.counters["picks_per_second"] =
+      benchmark::Counter(double(picks), benchmark::Counter::kIsRate);
+}
+
+void pick_args(benchmark::internal::Benchmark* b) {
+  for (int n : {10000, 1000000})
+    for (int s = 0; s < 3; ++s)
+      b->Args({n, s});
+}
+
 void build_args(benchmark::internal::Benchmark* b) {
   for (int n : {1000, 10000, 100000, 1000000})
     for (int layout = 0; layout < 3; ++layout)
@@ -184,3 +315,14 @@ BENCHMARK(BM_SplitCut)
     ->Arg(95)
     ->Arg(100)
     ->Iterations(1);
+BENCHMARK(BM_PickCpu)
+    ->Name("PickCpu")
+    ->Apply(pick_args)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
+BENCHMARK(BM_DevicePick)
+    ->Name("DevicePick")
+    ->Apply(pick_args)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(1.0);

@@ -68,6 +68,7 @@
 #define LT_XI_RES0 5.9604645e-08f /* 2^-24 */
 // 2^32 as a float (exact): scales a probability to the units of one 32-bit random word.
 #define LT_TWO_POW_32 4294967296.0f
+#define LT_TWO_POW_24 16777216.0f
 // Cone unions are padded by this angle (radians) so rounding never uncovers an input.
 #define LT_CONE_PAD 2e-6f
 // Importance terms (root_info.w). LT_TERMS_DISTANCE drops the orientation factors of Eq. 3 (the
@@ -868,17 +869,17 @@ LT_HOT float lt_lane_prob(float4 imp, int k) {
   return (s > 0.0f && ik > 0.0f) ? ik / s : 0.0f;
 }
 
-// Compare-and-swap of a sorting network on (value, lane) pairs, ascending.
+// Compare-and-swap of a sorting network on (value, lane) pairs, ascending; branch-free (selects),
+// since the order of the importances is data dependent and unpredictable.
 #define LT_CSWAP(va, ia, vb, ib)                                                                   \
   do {                                                                                             \
-    if (vb < va) {                                                                                 \
-      float tv_ = va;                                                                              \
-      int ti_ = ia;                                                                                \
-      va = vb;                                                                                     \
-      ia = ib;                                                                                     \
-      vb = tv_;                                                                                    \
-      ib = ti_;                                                                                    \
-    }                                                                                              \
+    int sw_ = vb < va;                                                                             \
+    float lo_ = sw_ ? vb : va, hi_ = sw_ ? va : vb;                                                \
+    int il_ = sw_ ? ib : ia, ih_ = sw_ ? ia : ib;                                                  \
+    va = lo_;                                                                                      \
+    vb = hi_;                                                                                      \
+    ia = il_;                                                                                      \
+    ib = ih_;                                                                                      \
   } while (0)
 
 // Chooses lane k with probability I_k / sum (what lt_lane_prob reports) from fresh 32-bit words
@@ -886,7 +887,7 @@ LT_HOT float lt_lane_prob(float4 imp, int k) {
 // network) and U in [0, 1) picks the lane whose interval [c_j, c_j+1) holds it, c_j = (sum of
 // the j smallest) / sum: summing from the small end keeps a tiny lane beside a big one, and every
 // boundary below a lane is at most 3 times that lane's own probability, so each lane's interval
-// has the lane's probability to a few float roundings (relative, ~1e-6) however small it is. The
+// has the lane's probability to a few float roundings (relative, < 1e-6) however small it is. The
 // comparisons of U with the boundaries are exact (lt_word_vs: one word, more only on a tie), so
 // no probability is lost to the resolution of U. A lane of importance 0 has an empty interval.
 LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
@@ -900,19 +901,27 @@ LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
   LT_CSWAP(v1, i1, v3, i3);
   LT_CSWAP(v1, i1, v2, i2);
   float t2 = v0 + v1;
-  // c_j * 2^32 (c_3 <= 3/4: the largest lane has at least a quarter)
-  float x1 = (v0 / s) * LT_TWO_POW_32;
-  float x2 = (t2 / s) * LT_TWO_POW_32;
-  float x3 = ((t2 + v2) / s) * LT_TWO_POW_32;
+  float t3 = t2 + v2;
   uint w = lt_rng_next_u32(r);
-  int o1 = lt_word_vs(w, &x1), o2 = lt_word_vs(w, &x2), o3 = lt_word_vs(w, &x3);
-  while (o1 == 2 || o2 == 2 || o3 == 2) { // tied boundaries compare with U's next word
-    w = lt_rng_next_u32(r);
-    if (o1 == 2) o1 = lt_word_vs(w, &x1);
-    if (o2 == 2) o2 = lt_word_vs(w, &x2);
-    if (o3 == 2) o3 = lt_word_vs(w, &x3);
+  // Fast path: U's top 24 bits a (exact as a float) against y_j = c_j * 2^24 (exact scaling of
+  // the boundary): U >= c_j if a >= y_j, U < c_j if a + 1 <= y_j; only a boundary strictly
+  // inside (a, a + 1) needs the exact 32-bit comparison (probability < 3 * 2^-24 per decision).
+  float k = LT_TWO_POW_24 / s; // c_3 <= 3/4 < 1: the largest lane has at least a quarter
+  float y1 = v0 * k, y2 = t2 * k, y3 = t3 * k;
+  float a = (float)(w >> 8);
+  float a1 = a + 1.0f;
+  int pos = (a >= y1) + (a >= y2) + (a >= y3); // boundaries at or below U
+  if ((y1 > a && y1 < a1) || (y2 > a && y2 < a1) || (y3 > a && y3 < a1)) {
+    float x1 = y1 * 256.0f, x2 = y2 * 256.0f, x3 = y3 * 256.0f; // c_j * 2^32, exact
+    int o1 = lt_word_vs(w, &x1), o2 = lt_word_vs(w, &x2), o3 = lt_word_vs(w, &x3);
+    while (o1 == 2 || o2 == 2 || o3 == 2) { // tied boundaries compare with U's next word
+      w = lt_rng_next_u32(r);
+      if (o1 == 2) o1 = lt_word_vs(w, &x1);
+      if (o2 == 2) o2 = lt_word_vs(w, &x2);
+      if (o3 == 2) o3 = lt_word_vs(w, &x3);
+    }
+    pos = o1 + o2 + o3;
   }
-  int pos = o1 + o2 + o3; // boundaries at or below U
   return pos == 0 ? i0 : (pos == 1 ? i1 : (pos == 2 ? i2 : i3));
 }
 

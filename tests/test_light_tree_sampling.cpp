@@ -1,5 +1,5 @@
-// Light samplers: pmf normalisation, sampled pmf == bit-trail pmf, chi-square fits (including the
-// xi precision on a 10^6-light tree), conservative importance, unbiasedness with and without
+// Light samplers: pmf normalisation, sampled pmf == bit-trail pmf, chi-square fits (including
+// paths of more than 24 bits of probability on a 10^6-light tree), conservative importance, unbiasedness with and without
 // splitting, scale invariance of the split decisions, zero-energy lights.
 #include "test_light_tree_util.h"
 
@@ -194,7 +194,9 @@ TEST(LightTreeSampling, ChiSquarePerLight) {
 namespace {
 // 4^10 coincident point lights whose energies make every lane probability dyadic:
 // at every level the four lanes have probabilities (1/2, 1/4, 1/8, 1/8) and a light's pmf is the
-// product over its base-4 digits. A path through many 1/8 lanes consumes up to 30 bits of xi.
+// product over its base-4 digits. A path through many 1/8 lanes has probability down to 2^-30
+// (one 24-bit uniform rescaled down the tree could not resolve it; every decision now draws a
+// fresh 32-bit word, lt_choose_lane).
 constexpr int kDyadicLevels = 10;
 constexpr double kLaneP[4] = {0.5, 0.25, 0.125, 0.125};
 std::vector<Light> dyadic_lights() {
@@ -211,7 +213,7 @@ std::vector<Light> dyadic_lights() {
   return lights;
 }
 
-// Bits of xi consumed by the first 8 decisions of light i (-log2 of their probabilities).
+// Bits of probability taken by the first 8 decisions of light i (-log2 of their probabilities).
 int prefix_bits(int i) {
   int bits = 0;
   for (int d = 0; d < kDyadicLevels - 2; ++d) {
@@ -223,7 +225,7 @@ int prefix_bits(int i) {
 
 // Chi-square score of picks grouped by the last two decisions (the last node level's lane and the
 // index in the leaf), separately for lights whose first 8 decisions consumed more than 20 bits
-// (where one rescaled 24-bit xi has <= 3 bits left for the last two) and the others.
+// (where one rescaled 24-bit uniform would have <= 3 bits left for the last two) and the others.
 double dyadic_chi2(const LightSampler& s, int picks, float3 P) {
   std::vector<std::vector<double>> part(2, std::vector<double>(32, 0.0));
   tbb::parallel_for(0, 2, [&](int t) {

@@ -136,15 +136,32 @@ inline double chi2_score(const std::vector<double>& observed, const std::vector<
 // Lights are split by `group` (bins never mix groups, so a small population is judged on its
 // own), sorted by probability within a group and merged into bins of expected count >=
 // min_expected (a trailing remainder joins the group's last bin). The chi-square over all bins is
-// compared with its 1 - alpha quantile (Wilson-Hilferty). A group whose whole expected count is
-// below min_expected cannot form a bin: its observed count must stay below the Poisson 1 - alpha
-// quantile of its expectation. A pick of a light of probability 0 always fails.
+// compared with its 1 - alpha quantile (Wilson-Hilferty); so is a second, coarse chi-square over
+// the group totals, which sees a whole group's deficit that the many fine bins dilute. A group
+// whose whole expected count is below min_expected cannot form a bin: its observed count must lie
+// within the two-sided Poisson alpha bounds of its expectation. A pick of a light of probability
+// 0 always fails.
 struct PickFit {
-  double chi2 = 0, quantile = 0;
-  int dof = 0;
-  std::string failures; // rare groups over their bound, impossible picks
-  bool pass() const { return failures.empty() && chi2 <= quantile; }
+  double chi2 = 0, quantile = 0;             // fine bins
+  double group_chi2 = 0, group_quantile = 0; // group totals
+  int dof = 0, group_dof = 0;
+  std::string failures; // rare groups outside their bounds, impossible picks
+  bool pass() const { return failures.empty() && chi2 <= quantile && group_chi2 <= group_quantile; }
 };
+inline double chi2_quantile(int dof, double z) { // Wilson-Hilferty
+  double k = dof, h = 2.0 / (9.0 * k);
+  return k * std::pow(1.0 - h + z * std::sqrt(h), 3.0);
+}
+inline double poisson_lower(double lambda, double alpha) { // largest q with P(X < q) <= alpha
+  double term = std::exp(-lambda), cdf = 0;
+  int q = 0;
+  while (cdf + term <= alpha && q < 100000) {
+    cdf += term;
+    ++q;
+    term *= lambda / q;
+  }
+  return q;
+}
 inline double poisson_upper(double lambda, double alpha) { // smallest q with P(X > q) <= alpha
   double term = std::exp(-lambda), cdf = term;
   int q = 0;
@@ -179,14 +196,16 @@ inline PickFit pick_fit(const std::vector<double>& counts, const std::vector<dou
       ge += prob[l] * total;
     }
     if (ge < min_expected) {
-      double bound = poisson_upper(ge, 1e-6);
-      if (go > bound)
+      double lo = poisson_lower(ge, 1e-6), hi = poisson_upper(ge, 1e-6);
+      if (go < lo || go > hi)
         f.failures += "group " + std::to_string(g) + ": " + std::to_string(go) +
-                      " picks, expected " + std::to_string(ge) + " (bound " +
-                      std::to_string(bound) + "); ";
+                      " picks, expected " + std::to_string(ge) + " (bounds " + std::to_string(lo) +
+                      ", " + std::to_string(hi) + "); ";
       i = end;
       continue;
     }
+    f.group_chi2 += (go - ge) * (go - ge) / ge;
+    ++f.group_dof;
     size_t first_bin = bo.size();
     double o = 0, e = 0;
     for (; i < end; ++i) {
@@ -208,8 +227,9 @@ inline PickFit pick_fit(const std::vector<double>& counts, const std::vector<dou
   for (size_t b = 0; b < bo.size(); ++b)
     f.chi2 += (bo[b] - be[b]) * (bo[b] - be[b]) / be[b];
   f.dof = std::max(1, bins - 1);
-  double k = f.dof, h = 2.0 / (9.0 * k);
-  f.quantile = k * std::pow(1.0 - h + z * std::sqrt(h), 3.0);
+  f.quantile = chi2_quantile(f.dof, z);
+  f.group_dof = std::max(1, f.group_dof - 1);
+  f.group_quantile = chi2_quantile(f.group_dof, z);
   return f;
 }
 
