@@ -54,10 +54,10 @@ INLINE int ray_triangle(float3 o, float3 d, float3 v0, float3 e1, float3 e2, flo
   float t = dot(e2, q) * inv_det;
   if (!(t > tmin && t < tmax)) return 0;
   // A hit within the rounding error of t is the surface the ray leaves (or geometry closer than
-  // float can resolve): reject it, as pbrt-v4's triangle test does (§6.8.7). The numerator
-  // dot(e2, cross(o - v0, e1)) has absolute error at most gamma(7) times the same sum of absolute
-  // products (o - v0 rounded, the cross product, the dot product; det's relative error adds
-  // gamma(3) t), so t's error is bounded below.
+  // float can resolve): reject it, as pbrt-v4's triangle test does (§6.8). The numerator
+  // dot(e2, cross(o - v0, e1)) is off by at most about gamma(7) times the same sum of absolute
+  // products (o - v0 rounded, the cross product, the dot product; gamma(8) keeps a margin), and
+  // det's relative error adds gamma(3) t.
   float3 as = fabs(s), a1 = fabs(e1);
   float3 aq =
       make_float3(as.y * a1.z + as.z * a1.y, as.z * a1.x + as.x * a1.z, as.x * a1.y + as.y * a1.x);
@@ -204,7 +204,7 @@ INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL int* prim_ind
 }
 
 // The hit point of ray o + t d on primitive prim (t, u, v from the intersection), computed so its
-// rounding error is small and bounded (pbrt-v4 §6.8.5): *p_err gets the absolute error bound per
+// rounding error is small and bounded (pbrt-v4 §6.8): *p_err gets the absolute error bound per
 // component, for offset_ray_origin. A triangle's point comes from its barycentrics (v0 + u e1 +
 // v e2 lies on the triangle's plane for any u, v; only the rounding of that sum is error), not
 // from o + t d, whose error grows with t and with |o|. A sphere's point is o + t d projected back

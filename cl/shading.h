@@ -23,7 +23,7 @@ INLINE float3 sample_cosine_hemisphere(float3 n, float u1, float u2) {
   return normalize(t * (r * cos(phi)) + b * (r * sin(phi)) + n * z);
 }
 
-// Floating-point error bounds (pbrt-v4 §6.8.1): gamma(n) = n u / (1 - n u) bounds the relative
+// Floating-point error bounds (pbrt-v4 §6.8): gamma(n) = n u / (1 - n u) bounds the relative
 // error of n successive float operations, u = 2^-24 the unit roundoff.
 INLINE float fp_gamma(int n) {
   float nu = (float)n * 5.9604645e-8f;
@@ -48,7 +48,7 @@ INLINE float next_float_down(float v) {
 // component, on the side of the (unit) normal n. The offset is the projection of the error box
 // onto n, so the origin is outside the box that holds the exact surface point, and each moved
 // component is rounded one more float away so the addition itself cannot pull it back (pbrt-v4
-// §6.8.6, OffsetRayOrigin). The offset follows the float error of the point's own coordinates:
+// §6.8, OffsetRayOrigin). The offset follows the float error of the point's own coordinates:
 // a floor far out along x with a small y and z keeps a tiny offset along its normal, whatever the
 // size of the scene.
 INLINE float3 offset_ray_origin(float3 p, float3 p_err, float3 n) {

@@ -18,6 +18,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <ostream>
+#include <string>
 
 using namespace canopy;
 
@@ -35,6 +37,12 @@ struct SpotCase {
   double start_frac; // falloff_start = start_frac * cone_angle (1: hard edge)
   bool write_start;  // false: leave falloff_start at its default (0.8 cone_angle)
 };
+
+// Readable test parameters in gtest and ctest listings (not the struct's raw bytes).
+void PrintTo(const SpotCase& c, std::ostream* os) {
+  *os << "cone " << c.cone_deg << " deg, tilt " << c.tilt_deg << " deg, falloff_start "
+      << (c.write_start ? std::to_string(c.start_frac) + " cone" : std::string("default"));
+}
 
 struct Spot {
   double p[3], a[3];          // position, unit axis (double, from the loaded float values)
