@@ -26,3 +26,11 @@ add_test(NAME cli_no_orientation_needs_a_tree
           "-DEXPECT=--no-orientation: applies to the tree samplers only (tree, tree-split), not power"
           -P ${CMAKE_CURRENT_SOURCE_DIR}/check_exit2.cmake)
 set_tests_properties(cli_no_orientation_needs_a_tree PROPERTIES LABELS cli TIMEOUT 120)
+
+# A film whose pixels exceed FLT_MAX: exit 0, one warning line, counted in the stats, finite image.
+add_test(NAME cli_film_overflow_is_counted_and_finite
+  COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:canopy>
+          -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/data/film_overflow.json
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/film_overflow
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/check_film_overflow.cmake)
+set_tests_properties(cli_film_overflow_is_counted_and_finite PROPERTIES LABELS cli TIMEOUT 180)
