@@ -112,3 +112,11 @@ canopy_cli_test(cli_spp_above_a_million
 canopy_cli_test(cli_spp_above_format_limit -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
   "-DARGS=--spp|16777217" "-DEXPECT=--spp: must be in [1, 16777216], got 16777217"
   -P ${CANOPY_CHECK2})
+
+# A film whose pixels exceed FLT_MAX: exit 0, one warning line, counted in the stats, finite image.
+add_test(NAME cli_film_overflow_is_counted_and_finite
+  COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:canopy>
+          -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/data/film_overflow.json
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/film_overflow
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/check_film_overflow.cmake)
+set_tests_properties(cli_film_overflow_is_counted_and_finite PROPERTIES LABELS cli TIMEOUT 180)

@@ -116,6 +116,11 @@ RgbImage Film::shadow_ray_heatmap(float max_rays) const {
 
 Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
     : rt_(rt), scene_(scene), options_(options) {
+  // The film is accumulated in double (cl/kernels/accumulate.cl).
+  if (rt.device().getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() == 0)
+    throw ClError(fmt::format("device {} has no double precision (cl_khr_fp64), which the film "
+                              "accumulation needs; choose another device with --device",
+                              rt.device_name()));
   auto t0 = Clock::now();
   for (const MaterialDesc& m : scene.materials)
     materials_.push_back(m.gpu);
@@ -124,12 +129,6 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
                                      options.max_cut, options.orientation_term);
   stats_.light_tree_seconds = sampler_.tree_build_seconds;
   stats_.build_seconds = seconds_since(t0);
-
-  // The film is accumulated in double (cl/kernels/accumulate.cl).
-  if (rt.device().getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() == 0)
-    throw ClError(fmt::format("device {} has no double precision (cl_khr_fp64), which the film "
-                              "accumulation needs; choose another device with --device",
-                              rt.device_name()));
 
   t0 = Clock::now();
   const cl::Context& ctx = rt.context();
