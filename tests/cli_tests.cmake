@@ -112,6 +112,15 @@ canopy_cli_test(cli_spp_above_a_million
 canopy_cli_test(cli_spp_above_format_limit -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
   "-DARGS=--spp|16777217" "-DEXPECT=--spp: must be in [1, 16777216], got 16777217"
   -P ${CANOPY_CHECK2})
+# NaN is refused by every floating-point option, of every subcommand.
+canopy_cli_test(cli_converge_budget_nan
+  "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--budget|nan"
+  -DRC=2 "-DSTDERR=canopy: --budget: must be a finite number (see --help)" -DONE_LINE=ON
+  -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_compare_error_scale_nan
+  "-DARGS=compare|${CANOPY_SCRATCH}/a.exr|${CANOPY_SCRATCH}/b.exr|--error-scale|nan"
+  -DRC=2 "-DSTDERR=canopy: --error-scale: must be a finite number (see --help)" -DONE_LINE=ON
+  -P ${CANOPY_CHECK_CLI})
 
 # A film whose pixels exceed FLT_MAX: exit 0, one warning line, counted in the stats, finite image.
 add_test(NAME cli_film_overflow_is_counted_and_finite

@@ -292,7 +292,7 @@ int main(int argc, char** argv) {
   render
       ->add_option("--split-threshold", rargs.split_threshold,
                    "tree-split threshold in [0, 1] (overrides the scene; 0 never splits)")
-      ->check(finite_number)
+      ->check(finite_number) // before the range: "not finite" says more than "not in range"
       ->check(CLI::Range(0.0, 1.0));
   render->add_flag("--no-orientation", rargs.no_orientation,
                    "Tree samplers: rank clusters by energy / distance^2 only (ablation of the "
@@ -307,6 +307,11 @@ int main(int argc, char** argv) {
   std::function<int()> action; // set by the subcommands defined in their own files
   add_compare_command(app, action);
   add_converge_command(app, action);
+
+  // Every floating-point option of every subcommand refuses NaN and infinities.
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::Option* opt : sub->get_options())
+      if (opt->get_type_name().rfind("FLOAT", 0) == 0) opt->check(finite_number);
 
   try {
     app.parse(argc, argv);

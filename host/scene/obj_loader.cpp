@@ -72,9 +72,13 @@ void check_obj_text(const std::string& text, const std::string& prefix) {
 // limit; tinyobjloader only warns about a missing one, and the scene format makes that an error.
 void check_mtllibs(const std::string& text, const std::filesystem::path& dir,
                    const std::string& prefix) {
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line)) {
+  for (size_t pos = 0; pos < text.size();) {
+    size_t eol = text.find('\n', pos);
+    if (eol == std::string::npos) eol = text.size();
+    std::string_view view(text.data() + pos, eol - pos);
+    pos = eol + 1;
+    if (view.find("mtllib") == std::string_view::npos) continue;
+    std::string line(view);
     size_t i = line.find_first_not_of(" \t");
     if (i == std::string::npos || line.compare(i, 6, "mtllib") != 0) continue;
     if (i + 6 < line.size() && line[i + 6] != ' ' && line[i + 6] != '\t') continue;
@@ -120,6 +124,15 @@ private:
   std::string prefix_;
 };
 
+// An istream over a string without copying it (an OBJ may be up to kMaxObjFileBytes).
+class StringViewBuf : public std::streambuf {
+public:
+  explicit StringViewBuf(const std::string& s) {
+    char* p = const_cast<char*>(s.data()); // read-only use: the get area is never written
+    setg(p, p, p + s.size());
+  }
+};
+
 bool finite_nonneg3(const tinyobj::real_t* c) {
   for (int i = 0; i < 3; ++i)
     if (!std::isfinite(c[i]) || c[i] < 0) return false;
@@ -145,7 +158,8 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
-  std::istringstream in(text);
+  StringViewBuf buf(text);
+  std::istream in(&buf);
   CheckedMaterialReader mtl_reader(dir, prefix);
   bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, &mtl_reader,
                              /*triangulate=*/true);
