@@ -14,4 +14,6 @@ extern "C" const char* __lsan_default_suppressions() {
 }
 
 // A UB report with the stack that led to it.
-extern "C" const char* __ubsan_default_options() { return "print_stacktrace=1"; }
+extern "C" const char* __ubsan_default_options() {
+  return "print_stacktrace=1";
+}
