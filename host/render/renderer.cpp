@@ -165,12 +165,12 @@ Film Renderer::render(const RenderSettings& settings) {
   const int max_depth = scene_.integrator.max_depth;
   // Fail before any work if the film or the wave does not fit (docs/limits.md).
   check_memory(rt_.device(),
-               {{"film_sum", uint64_t(npix) * sizeof(float4)},
-                {"film_sumsq", uint64_t(npix) * sizeof(float4)},
-                {"film_counts", uint64_t(npix) * sizeof(float2)},
+               {{"film_sum", uint64_t(npix) * sizeof(double4)},
+                {"film_sumsq", uint64_t(npix) * sizeof(double4)},
+                {"film_counts", uint64_t(npix) * sizeof(double2)},
                 {"shadow_stage", 4 * uint64_t(split_cap) * sizeof(ShadowItem)},
                 {"child_stage", 4 * uint64_t(split_cap) * sizeof(SplitItem)}},
-               {{"film (host copy)", uint64_t(npix) * (2 * sizeof(float4) + sizeof(float2))},
+               {{"film (host copy)", uint64_t(npix) * (2 * sizeof(double4) + sizeof(double2))},
                 {"image", uint64_t(npix) * 3 * sizeof(float)}},
                printable(scene_.path.string(), 1024));
 
