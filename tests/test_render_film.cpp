@@ -184,11 +184,12 @@ INSTANTIATE_TEST_SUITE_P(Bright, RenderFilmEmission,
                                             ::testing::Values("uniform", "exhaustive", "power",
                                                               "tree", "tree-split")),
                          emission_case_name);
-// The tree samplers' pick of a denormal-energy light is item A of issue 9 (light-tree energies),
-// not the film's; they join this list with that change.
+// The tree samplers need the light tree's energies normalised too (its emitter records and node
+// energies would otherwise be denormal and flush to zero on the device).
 INSTANTIATE_TEST_SUITE_P(Denormal, RenderFilmEmission,
                          ::testing::Combine(::testing::Values(1e-40f),
-                                            ::testing::Values("uniform", "exhaustive", "power")),
+                                            ::testing::Values("uniform", "exhaustive", "power",
+                                                              "tree", "tree-split")),
                          emission_case_name);
 
 TEST(RenderFilm, ManyDenormalLightsEachBelowTheSmallestFloatAddUp) {
