@@ -411,21 +411,19 @@ INLINE uint lt_mulhi(uint a, uint b) {
 #endif
 }
 
-// A uniform index in [0, n), n >= 1: (u * n) >> 32 from a 32-bit word u, with Lemire's rejection
-// ("Fast Random Integer Generation in an Interval", 2019) so every index has exactly 1/n: the low
-// half of u * n below 2^32 mod n marks the words that would give some indices one extra preimage
-// (probability < n / 2^32 per draw; the modulo is only computed then).
+// A uniform index in [0, n), n >= 1: floor(W n / 2^64) for a 64-bit random W (two words), with a
+// 32 x 32-bit multiply-high per word and no loop (a rejection loop, Lemire 2019, would be exact
+// but keeps PoCL from vectorising the kernel across work items: 3x the cost of a uniform pick).
+// Every index has floor or ceil of 2^64 / n of the 2^64 values of W: its probability is 1/n to a
+// relative n * 2^-64 (< 3e-12 for the format's 5e7 lights, far below the float pmf's own 6e-8).
+// A 24-bit float u could not reach more than 2^24 lights, and u32 * n >> 32 alone would be off by
+// up to n * 2^-32 (1% at 5e7 lights).
 INLINE uint lt_rng_index(LtRng* r, uint n) {
-  uint u = lt_rng_next_u32(r);
-  uint lo = u * n;
-  if (lo < n) {
-    uint t = (0u - n) % n; // 2^32 mod n
-    while (lo < t) {
-      u = lt_rng_next_u32(r);
-      lo = u * n;
-    }
-  }
-  return lt_mulhi(u, n);
+  uint w1 = lt_rng_next_u32(r); // high word of W
+  uint w0 = lt_rng_next_u32(r);
+  uint mid = w1 * n;                              // low half of w1 * n (weight 2^32)
+  uint sum = mid + lt_mulhi(w0, n);               // plus the high half of w0 * n
+  return lt_mulhi(w1, n) + (sum < mid ? 1u : 0u); // carry into 2^64
 }
 
 // One 32-bit word w of a uniform U = 0.w1 w2 w3 ... (binary) against a boundary whose scaled value
@@ -433,8 +431,8 @@ INLINE uint lt_rng_index(LtRng* r, uint n) {
 // [0, 2^32). Returns 1 if U >= c, 0 if U < c, 2 if w ties with floor(*x) and the boundary has a
 // nonzero fraction: then *x becomes that fraction * 2^32 for the next word. x - floor(x) of a
 // float is exact, and so is the scaling, so each word compares 32 more bits of the boundary
-// exactly: a float boundary (24 significant bits, exponent >= -149) is resolved after at most 6
-// words, and a tie happens with probability 2^-32 per word.
+// exactly: a float boundary in (0, 1) has no bit below 2^-149, so it is resolved after at most 5
+// words (LT_MAX_WORDS), and a tie happens with probability 2^-32 per word.
 INLINE int lt_word_vs(uint w, float* x) {
   float f = floor(*x);
   uint fi = (uint)f;
@@ -444,6 +442,11 @@ INLINE int lt_word_vs(uint w, float* x) {
   return 2;
 }
 
+// Words of U that can be needed to compare it with a float boundary: its lowest bit is at
+// 2^-149 or above, and 5 words hold 160 bits. A fixed count (no data-dependent loop) keeps kernels
+// vectorisable; after LT_MAX_WORDS words a tie cannot remain.
+#define LT_MAX_WORDS 5
+
 // P(result = 1) = c exactly, for any float c (denormals included; c <= 0 or NaN: never, c >= 1:
 // always). w is U's first word; further words are drawn from r only on a tie.
 INLINE int lt_u_below(uint w, float c, LtRng* r) {
@@ -451,8 +454,8 @@ INLINE int lt_u_below(uint w, float c, LtRng* r) {
   if (c >= 1.0f) return 1;
   float x = c * LT_TWO_POW_32;
   int o = lt_word_vs(w, &x);
-  while (o == 2)
-    o = lt_word_vs(lt_rng_next_u32(r), &x);
+  for (int k = 1; k < LT_MAX_WORDS; ++k)
+    if (o == 2) o = lt_word_vs(lt_rng_next_u32(r), &x);
   return o == 0;
 }
 
@@ -914,13 +917,14 @@ LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
   if ((y1 > a && y1 < a1) || (y2 > a && y2 < a1) || (y3 > a && y3 < a1)) {
     float x1 = y1 * 256.0f, x2 = y2 * 256.0f, x3 = y3 * 256.0f; // c_j * 2^32, exact
     int o1 = lt_word_vs(w, &x1), o2 = lt_word_vs(w, &x2), o3 = lt_word_vs(w, &x3);
-    while (o1 == 2 || o2 == 2 || o3 == 2) { // tied boundaries compare with U's next word
+    for (int n = 1; n < LT_MAX_WORDS; ++n) { // tied boundaries compare with U's next word
+      if (o1 != 2 && o2 != 2 && o3 != 2) break;
       w = lt_rng_next_u32(r);
       if (o1 == 2) o1 = lt_word_vs(w, &x1);
       if (o2 == 2) o2 = lt_word_vs(w, &x2);
       if (o3 == 2) o3 = lt_word_vs(w, &x3);
     }
-    pos = o1 + o2 + o3;
+    pos = (o1 == 1) + (o2 == 1) + (o3 == 1);
   }
   return pos == 0 ? i0 : (pos == 1 ? i1 : (pos == 2 ? i2 : i3));
 }

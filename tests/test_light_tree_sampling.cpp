@@ -1,9 +1,12 @@
 // Light samplers: pmf normalisation, sampled pmf == bit-trail pmf, chi-square fits (including
-// paths of more than 24 bits of probability on a 10^6-light tree), conservative importance, unbiasedness with and without
-// splitting, scale invariance of the split decisions, zero-energy lights.
+// paths of more than 24 bits of probability on a 10^6-light tree), conservative importance,
+// unbiasedness with and without splitting, scale invariance of the split decisions, zero-energy
+// lights.
 #include "test_light_tree_util.h"
 
 #include <gtest/gtest.h>
+
+#include <cfloat>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -569,6 +572,48 @@ TEST(LightTreeSampling, ShadingPointInsideClusters) {
     for (float3 N : {make_float3(0, 0, 0), make_float3(0, 1, 0)}) {
       double sum = pmf_sum(*s, P, N);
       EXPECT_NEAR(sum, 1.0, 1e-4);
+    }
+  }
+}
+
+TEST(LightTreeSampling, EmissionScaleDoesNotChangeThePmf) {
+  // Emission anywhere from float's denormal range (2^-140 ~ 7e-43) to near its maximum (2^110 ~
+  // 1e33, times 100) gives the same tree and power pmfs, bit for bit: the energies are computed in
+  // double and normalised by a power of two (normalize_emitter_energies), so a common power-of-two
+  // factor changes nothing. Before, 1e-40 emission made the tree's importances 0 / NaN (black).
+  std::vector<Light> base = mixed_lights(300, 21, 10.0f);
+  LtRng r = lt_rng_make(5, 5);
+  for (Light& l : base) {
+    float k = float(1 + int(lt_rng_next(&r) * 100.0f));
+    l.emission = make_float4(k, k, k, 0.0f);
+  }
+  std::vector<Shade> pts = shading_points(20, -1.0f, 11.0f, 9);
+  for (const char* name : {"tree", "tree-split", "power"}) {
+    auto ref = make_light_sampler(name, base);
+    for (int e : {-140, 110}) {
+      std::vector<Light> scaled = base;
+      for (Light& l : scaled) {
+        l.emission.x = std::ldexp(l.emission.x, e);
+        l.emission.y = std::ldexp(l.emission.y, e);
+        l.emission.z = std::ldexp(l.emission.z, e);
+      }
+      auto s = make_light_sampler(name, scaled);
+      for (const Shade& x : pts)
+        for (int l = 0; l < int(base.size()); ++l)
+          ASSERT_EQ(s->pmf(x.P, x.N, l), ref->pmf(x.P, x.N, l))
+              << name << " scale 2^" << e << " light " << l;
+      if (const LightTree* t = s->tree()) {
+        // node lane energies and emitter record energies: 0 (empty lane) or normal and finite
+        auto ok = [](float x) { return x == 0.0f || (x >= FLT_MIN && std::isfinite(x)); };
+        for (int n = 0; n < t->num_nodes(); ++n) {
+          float4 v = t->nodes[size_t(n) * LT_NODE_F4 + LT_ENERGY];
+          ASSERT_TRUE(ok(v.x) && ok(v.y) && ok(v.z) && ok(v.w)) << name << " node " << n;
+        }
+        for (size_t i = size_t(t->num_nodes()) * LT_NODE_F4 + 1; i < t->nodes.size();
+             i += LT_EMITTER_F4)
+          ASSERT_TRUE(t->nodes[i].z >= FLT_MIN && std::isfinite(t->nodes[i].z)) << name;
+        EXPECT_EQ(t->energy_scale, std::ldexp(ref->tree()->energy_scale, -e));
+      }
     }
   }
 }

@@ -452,8 +452,8 @@ float BinaryLightNode::cv2() const {
 EmitterBounds emitter_bounds(const Light& light) {
   EmitterBounds b;
   float3 axis;
-  float co, ce, e;
-  lt_light_bounds(&light, &b.bmin, &b.bmax, &axis, &co, &ce, &e);
+  float co, ce, e_float; // lt_light_bounds' float energy underflows for emission ~1e-40: unused
+  lt_light_bounds(&light, &b.bmin, &b.bmax, &axis, &co, &ce, &e_float);
   b.cos_o = co;
   b.cos_e = ce;
   float to = co >= 1.0f ? 0.0f : (co <= -1.0f ? kPi : std::acos(co));
@@ -473,7 +473,6 @@ EmitterBounds emitter_bounds(const Light& light) {
     double area = std::sqrt(cx * cx + cy * cy + cz * cz);
     energy = lum * (light.type == LIGHT_QUAD ? area : 0.5 * area);
   }
-  (void)e;
   b.energy = (energy > 0 && std::isfinite(energy)) ? energy : 0.0;
   return b;
 }
