@@ -476,7 +476,9 @@ def m_emission(rng, tree, m):
         if key_of(p, i) in EMISSION_KEYS:
             put(p, i, Raw(val))
             n += 1
-    m.ops.append(f"emission all = {val} ({n} values)")
+    # 16 samples per pixel: one sample cannot overflow the film's per-pixel sum (finding 4).
+    m.args = ["--spp", "16"]
+    m.ops.append(f"emission all = {val} ({n} values), --spp 16")
     return n > 0
 
 
@@ -1125,7 +1127,7 @@ def summarize(results):
     for r in results:
         op = r["ops"][0].split()[0] if r["kind"] == "special" else (
             "bytes" if r["kind"] == "bytes" else
-            r["kind"] + ":" + (r["ops"][0].split()[0] if r["kind"] == "json" and r["ops"] else ""))
+            r["kind"] + ":" + (r["ops"][0].split()[0].rstrip(":") if r["kind"] == "json" and r["ops"] else ""))
         if r["kind"] == "obj":
             op = "obj/mtl"
         if r["kind"] == "special":
