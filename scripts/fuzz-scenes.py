@@ -1058,9 +1058,9 @@ def run_one(m, args, work, failures):
             # The kernel enforces the limit on the process itself: /dev/zero read without bound
             # ends in bad_alloc instead of exhausting the machine.
             run = ["/bin/sh", "-c", f'ulimit -v {args.mem_limit_mb * 1024} && exec "$@"', "sh"] + cmd
-        # A render that times out is run once more with three times the timeout, so a slow
-        # render on a busy machine is not mistaken for a hang.
-        for limit in (args.timeout, 3 * args.timeout):
+        # A render that times out is run again with three times the timeout (--retries), so a
+        # slow render on a busy machine is not mistaken for a hang.
+        for limit in [args.timeout] + [3 * args.timeout] * args.retries:
             if (wdir / "out.exr").exists():
                 (wdir / "out.exr").unlink()
             p = subprocess.Popen(run, cwd=wdir, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
@@ -1175,8 +1175,9 @@ def main():
     ap.add_argument("--count", type=int, default=1000, help="number of mutants (default 1000)")
     ap.add_argument("--jobs", type=int, default=2, help="renders in parallel")
     ap.add_argument("--seed", type=int, default=1, help="fuzzer seed (the mutants depend on it)")
-    ap.add_argument("--timeout", type=float, default=20.0,
-                    help="seconds per render (a timed-out render is retried with 3x this)")
+    ap.add_argument("--timeout", type=float, default=20.0, help="seconds per render")
+    ap.add_argument("--retries", type=int, default=1,
+                    help="reruns of a timed-out render, with 3x the timeout (default 1)")
     ap.add_argument("--mem-limit-mb", type=int, default=4096,
                     help="address-space limit per render (0: none; must be 0 under ASan)")
     ap.add_argument("--out", default="fuzz-out", help="output directory (failures/, results.jsonl)")
