@@ -476,7 +476,9 @@ def m_emission(rng, tree, m):
         if key_of(p, i) in EMISSION_KEYS:
             put(p, i, Raw(val))
             n += 1
-    m.ops.append(f"emission all = {val} ({n} values)")
+    # 16 samples per pixel: one sample cannot overflow the film's per-pixel sum (finding 4).
+    m.args = ["--spp", "16"]
+    m.ops.append(f"emission all = {val} ({n} values), --spp 16")
     return n > 0
 
 
@@ -869,6 +871,15 @@ def special_cases():
                      ("--seed", "4294967296"), ("--light-sampler", "bogus"),
                      ("--light-sampler", "a\nb")]:
         case(f"cli {opt} {val!r}", files=good, args=[opt, val], names=opt)
+    # Emission near the float maximum at 16 spp: the film's per-pixel sum must not overflow to Inf
+    # (finding 4 of issue 9); exit 0 with a finite image or a one-line error.
+    hot = parse((ROOT / "tests/fuzz/lights.json").read_text())
+    set_member(hot, "film", Obj([["width", FILM], ["height", FILM]]))
+    for p, i, _ in list(slots(hot)):
+        if key_of(p, i) in EMISSION_KEYS:
+            put(p, i, Raw("3e38"))
+    cases.append(("emission 3e38 at 16 spp", "scene.json", {"scene.json": dump(hot)}, [],
+                  ["--spp", "16"], None))
     return cases
 
 
@@ -890,14 +901,14 @@ def make_mutant(ident, base_seed, seeds, specials):
     if ident < len(specials):
         kind, arg, files, setup, args, names = specials[ident]
         m = Mutant(ident, None)
-        m.kind = "cli" if args else "special"
+        m.kind = "cli" if kind.startswith("cli ") else "special"
         m.ops.append(kind)
         m.scene_arg = arg
         m.files = dict(files)
         m.setup = setup
         m.args = args
         m.names = names
-        m.expect_error = True
+        m.expect_error = kind.startswith(("scene-", "obj-", "mtl-", "cli "))
         return m
     rng = random.Random(f"{base_seed}/{ident}")
     for _attempt in range(50):
@@ -1047,9 +1058,9 @@ def run_one(m, args, work, failures):
             # The kernel enforces the limit on the process itself: /dev/zero read without bound
             # ends in bad_alloc instead of exhausting the machine.
             run = ["/bin/sh", "-c", f'ulimit -v {args.mem_limit_mb * 1024} && exec "$@"', "sh"] + cmd
-        # A render that times out is run once more with three times the timeout, so a slow
-        # render on a busy machine is not mistaken for a hang.
-        for limit in (args.timeout, 3 * args.timeout):
+        # A render that times out is run again with three times the timeout (--retries), so a
+        # slow render on a busy machine is not mistaken for a hang.
+        for limit in [args.timeout] + [3 * args.timeout] * args.retries:
             if (wdir / "out.exr").exists():
                 (wdir / "out.exr").unlink()
             p = subprocess.Popen(run, cwd=wdir, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
@@ -1125,7 +1136,7 @@ def summarize(results):
     for r in results:
         op = r["ops"][0].split()[0] if r["kind"] == "special" else (
             "bytes" if r["kind"] == "bytes" else
-            r["kind"] + ":" + (r["ops"][0].split()[0] if r["kind"] == "json" and r["ops"] else ""))
+            r["kind"] + ":" + (r["ops"][0].split()[0].rstrip(":") if r["kind"] == "json" and r["ops"] else ""))
         if r["kind"] == "obj":
             op = "obj/mtl"
         if r["kind"] == "special":
@@ -1164,8 +1175,9 @@ def main():
     ap.add_argument("--count", type=int, default=1000, help="number of mutants (default 1000)")
     ap.add_argument("--jobs", type=int, default=2, help="renders in parallel")
     ap.add_argument("--seed", type=int, default=1, help="fuzzer seed (the mutants depend on it)")
-    ap.add_argument("--timeout", type=float, default=20.0,
-                    help="seconds per render (a timed-out render is retried with 3x this)")
+    ap.add_argument("--timeout", type=float, default=20.0, help="seconds per render")
+    ap.add_argument("--retries", type=int, default=1,
+                    help="reruns of a timed-out render, with 3x the timeout (default 1)")
     ap.add_argument("--mem-limit-mb", type=int, default=4096,
                     help="address-space limit per render (0: none; must be 0 under ASan)")
     ap.add_argument("--out", default="fuzz-out", help="output directory (failures/, results.jsonl)")
