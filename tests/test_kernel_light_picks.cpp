@@ -89,21 +89,9 @@ Outcome run_case(ClRuntime& rt, const Case& c) {
     return {};
   }
   std::printf("  sampler data %.2f s", secs());
-  DeviceScene d;
   const cl::Context& ctx = rt.context();
-  d.lights = upload_buffer(ctx, c.lights);
-  d.power_pmf = upload_buffer(ctx, data.power_pmf);
-  d.alias_prob = upload_buffer(ctx, data.alias_prob);
-  d.alias_index = upload_buffer(ctx, data.alias_index);
-  d.lt_nodes = upload_buffer(ctx, data.tree.nodes);
-  d.lt_children = upload_buffer(ctx, data.tree.children);
-  d.lt_leaf_lights = upload_buffer(ctx, data.tree.leaf_lights);
-  d.lt_trails = upload_buffer(ctx, data.tree.trails);
-  d.light_count = n;
-  d.root_sphere = data.tree.root_sphere;
-  d.root_info = data.tree.root_info;
-  d.split_threshold = data.threshold;
-  d.max_cut = data.root_budget();
+  DeviceScene d;
+  upload_light_sampler(ctx, c.lights, data, 0, d);
 
   std::vector<int> zeros(size_t(n) + 1, 0);
   cl::Buffer hist = upload_buffer(ctx, zeros, CL_MEM_READ_WRITE);

@@ -39,6 +39,12 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
   d.prim_index = upload_buffer(ctx, geometry.bvh.prim_index);
   d.prims = upload_buffer(ctx, geometry.prims);
   d.materials = upload_buffer(ctx, materials);
+  upload_light_sampler(ctx, lights, sampler, emission_exponent, d);
+  return d;
+}
+
+void upload_light_sampler(const cl::Context& ctx, const std::vector<Light>& lights,
+                          const LightSamplerData& sampler, int emission_exponent, DeviceScene& d) {
   d.lights = upload_scaled_lights(ctx, lights, emission_exponent);
   d.power_pmf = upload_buffer(ctx, sampler.power_pmf);
   d.alias_prob = upload_buffer(ctx, sampler.alias_prob);
@@ -52,7 +58,6 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
   d.root_info = sampler.tree.root_info;
   d.split_threshold = sampler.threshold;
   d.max_cut = sampler.root_budget();
-  return d;
 }
 
 int DeviceScene::set_bvh_args(cl::Kernel& k, int i) const {

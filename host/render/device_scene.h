@@ -45,4 +45,9 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
                                 int emission_exponent = 0);
 
+// Uploads only the lights and the light sampler's buffers into `d` (the part of
+// upload_device_scene that the pick tests and benchmarks need without any geometry).
+void upload_light_sampler(const cl::Context& ctx, const std::vector<Light>& lights,
+                          const LightSamplerData& sampler, int emission_exponent, DeviceScene& d);
+
 } // namespace canopy
