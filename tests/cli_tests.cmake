@@ -112,6 +112,21 @@ canopy_cli_test(cli_spp_above_a_million
 canopy_cli_test(cli_spp_above_format_limit -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
   "-DARGS=--spp|16777217" "-DEXPECT=--spp: must be in [1, 16777216], got 16777217"
   -P ${CANOPY_CHECK2})
+# Issue 10: a scene without sampler settings renders with tree-split at the measured default
+# threshold and pbrt-v4's default depth, and the summary line says so; --max-cut and --max-depth
+# override the scene and are range-checked.
+canopy_cli_test(cli_default_sampler_summary
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--out|${CANOPY_SCRATCH}/defaults.exr"
+  "-DSTDERR=1 spp, sampler tree-split (threshold 0.25, max cut 64), max depth 5, 1 lights"
+  -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_max_cut_option
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--max-cut|3|--max-depth|2|--out|${CANOPY_SCRATCH}/max_cut.exr"
+  "-DSTDERR=sampler tree-split (threshold 0.25, max cut 3), max depth 2" -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_max_cut_zero -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  "-DARGS=--max-cut|0" "-DEXPECT=--max-cut: must be in [1, 65536], got 0" -P ${CANOPY_CHECK2})
+canopy_cli_test(cli_max_depth_too_large -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
+  "-DARGS=--max-depth|1025" "-DEXPECT=--max-depth: must be in [1, 1024], got 1025"
+  -P ${CANOPY_CHECK2})
 # NaN is refused by every floating-point option, of every subcommand.
 canopy_cli_test(cli_converge_budget_nan
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--budget|nan"

@@ -225,6 +225,15 @@ TEST(SceneErrors, SplitThresholdAboveOne) {
             "scene.json: integrator.split_threshold: must be in [0, 1]");
 }
 
+TEST(SceneErrors, MaxCutOutOfRange) {
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"max_cut": 0})")),
+            "scene.json: integrator.max_cut: must be in [1, 65536]");
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"max_cut": 65537})")),
+            "scene.json: integrator.max_cut: must be in [1, 65536]");
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"max_cut": 2.5})")),
+            "scene.json: integrator.max_cut: must be an integer");
+}
+
 TEST(SceneErrors, SeedNegative) {
   EXPECT_EQ(error_of(scene_with(R"("integrator": {"seed": -1})")),
             "scene.json: integrator.seed: must be in [0, 4294967295]");

@@ -29,7 +29,7 @@ TEST(SceneLoader, CameraFilmIntegrator) {
     "camera": {"position": [1, 2, 3], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 60},
     "film": {"width": 320, "height": 200},
     "integrator": {"spp": 7, "max_depth": 4, "light_sampler": "tree-split",
-                   "split_threshold": 0.5, "seed": 4294967295},
+                   "split_threshold": 0.5, "max_cut": 9, "seed": 4294967295},
     "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}]
   })");
   EXPECT_FLOAT_EQ(s.camera.position.x, 1);
@@ -43,6 +43,7 @@ TEST(SceneLoader, CameraFilmIntegrator) {
   EXPECT_EQ(s.integrator.max_depth, 4);
   EXPECT_EQ(s.integrator.light_sampler, "tree-split");
   EXPECT_FLOAT_EQ(s.integrator.split_threshold, 0.5f);
+  EXPECT_EQ(s.integrator.max_cut, 9);
   EXPECT_EQ(s.integrator.seed, 4294967295u);
   EXPECT_EQ(s.path, "scene.json");
 }
@@ -54,9 +55,11 @@ TEST(SceneLoader, Defaults) {
   EXPECT_EQ(s.film.width, 640);
   EXPECT_EQ(s.film.height, 480);
   EXPECT_EQ(s.integrator.spp, 16);
-  EXPECT_EQ(s.integrator.max_depth, 1);
-  EXPECT_EQ(s.integrator.light_sampler, "uniform");
-  EXPECT_FLOAT_EQ(s.integrator.split_threshold, 0.85f);
+  // Without sampler settings the renderer shows its best: tree-split at the measured threshold.
+  EXPECT_EQ(s.integrator.max_depth, 5);
+  EXPECT_EQ(s.integrator.light_sampler, "tree-split");
+  EXPECT_FLOAT_EQ(s.integrator.split_threshold, LT_DEFAULT_SPLIT_THRESHOLD);
+  EXPECT_EQ(s.integrator.max_cut, 64);
   EXPECT_EQ(s.integrator.seed, 1u);
   ASSERT_EQ(s.materials.size(), 1u);
   EXPECT_EQ(s.materials[0].name, "default");

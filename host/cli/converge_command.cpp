@@ -230,6 +230,7 @@ void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, P
   RendererOptions opt;
   opt.light_sampler = c.sampler;
   opt.split_threshold = c.threshold;
+  opt.max_cut = base.integrator.max_cut;
   opt.orientation_term = c.orientation;
   Renderer r(rt, scene, opt);
   const int half_spp = std::max(1, a.reference_spp / 2);
@@ -359,6 +360,7 @@ int run_converge(const ConvergeArgs& a) {
     RendererOptions opt;
     opt.light_sampler = res.config.sampler;
     opt.split_threshold = res.config.threshold;
+    opt.max_cut = base.integrator.max_cut;
     opt.orientation_term = res.config.orientation;
     renderers.push_back(std::make_unique<Renderer>(rt, *scenes.back(), opt));
     Renderer& renderer = *renderers.back();

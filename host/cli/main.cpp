@@ -46,6 +46,8 @@ struct RenderArgs {
   std::optional<uint32_t> seed;
   std::optional<std::string> light_sampler;
   std::optional<float> split_threshold;
+  std::optional<int> max_cut;
+  std::optional<int> max_depth;
   bool no_orientation = false;
   std::string out, png, device, stats_json, heatmap;
   bool stats = false;
@@ -141,6 +143,23 @@ void check_writable(const fs::path& file, const char* option) {
   ::unlink(name.data());
 }
 
+// "sampler tree-split (threshold 0.5, max cut 64)": what the summary line says of the light
+// sampler; only the settings that apply to it.
+std::string sampler_summary(const IntegratorSettings& in, bool orientation_term) {
+  std::string s = "sampler " + in.light_sampler;
+  std::vector<std::string> parts;
+  if (in.light_sampler == "tree-split") {
+    parts.push_back(fmt::format("threshold {}", in.split_threshold));
+    parts.push_back(fmt::format("max cut {}", in.max_cut));
+  }
+  if (!orientation_term) parts.push_back("no orientation");
+  if (parts.empty()) return s;
+  s += " (";
+  for (size_t i = 0; i < parts.size(); ++i)
+    s += (i ? ", " : "") + parts[i];
+  return s + ")";
+}
+
 int run_render(const RenderArgs& args) {
   auto t_start = std::chrono::steady_clock::now();
   Scene scene = load_scene(args.scene);
@@ -155,6 +174,18 @@ int run_render(const RenderArgs& args) {
   if (args.seed) scene.integrator.seed = *args.seed;
   if (args.light_sampler) scene.integrator.light_sampler = *args.light_sampler;
   if (args.split_threshold) scene.integrator.split_threshold = *args.split_threshold;
+  if (args.max_cut) {
+    if (*args.max_cut < 1 || *args.max_cut > kMaxMaxCut)
+      throw SceneError(
+          fmt::format("--max-cut: must be in [1, {}], got {}", kMaxMaxCut, *args.max_cut));
+    scene.integrator.max_cut = *args.max_cut;
+  }
+  if (args.max_depth) {
+    if (*args.max_depth < 1 || *args.max_depth > kMaxDepth)
+      throw SceneError(
+          fmt::format("--max-depth: must be in [1, {}], got {}", kMaxDepth, *args.max_depth));
+    scene.integrator.max_depth = *args.max_depth;
+  }
   if (args.no_orientation && scene.integrator.light_sampler.rfind("tree", 0) != 0)
     throw SceneError(fmt::format(
         "--no-orientation: applies to the tree samplers only (tree, tree-split), not {}",
@@ -189,6 +220,7 @@ int run_render(const RenderArgs& args) {
   RendererOptions ropt;
   ropt.light_sampler = scene.integrator.light_sampler;
   ropt.split_threshold = scene.integrator.split_threshold;
+  ropt.max_cut = scene.integrator.max_cut;
   ropt.orientation_term = !args.no_orientation;
   Renderer renderer(rt, scene, ropt);
   ProgressBar bar;
@@ -209,6 +241,8 @@ int run_render(const RenderArgs& args) {
             {{"canopy:scene", args.scene},
              {"canopy:light_sampler", scene.integrator.light_sampler},
              {"canopy:split_threshold", fmt::format("{}", scene.integrator.split_threshold)},
+             {"canopy:max_cut", std::to_string(scene.integrator.max_cut)},
+             {"canopy:max_depth", std::to_string(scene.integrator.max_depth)},
              {"canopy:orientation_term", args.no_orientation ? "off" : "on"},
              {"canopy:spp", std::to_string(scene.integrator.spp)},
              {"canopy:seed", std::to_string(scene.integrator.seed)}});
@@ -218,10 +252,11 @@ int run_render(const RenderArgs& args) {
   std::string skipped = scene.skipped_lights
                             ? fmt::format(" ({} with zero emission skipped)", scene.skipped_lights)
                             : std::string();
-  std::fprintf(stderr, "%s: %dx%d, %d spp, %zu lights%s, %zu primitives on %s\n",
+  std::fprintf(stderr, "%s: %dx%d, %d spp, %s, max depth %d, %zu lights%s, %zu primitives on %s\n",
                scene_name.c_str(), scene.film.width, scene.film.height, scene.integrator.spp,
-               scene.lights.size(), skipped.c_str(), renderer.geometry().prims.size(),
-               rt.device_name().c_str());
+               sampler_summary(scene.integrator, !args.no_orientation).c_str(),
+               scene.integrator.max_depth, scene.lights.size(), skipped.c_str(),
+               renderer.geometry().prims.size(), rt.device_name().c_str());
   std::fprintf(stderr, "build %.3f s, compile %.3f s, render %.3f s%s\n", st.build_seconds,
                st.compile_seconds, st.render_seconds,
                st.nonfinite_samples
@@ -234,6 +269,9 @@ int run_render(const RenderArgs& args) {
     nlohmann::json j = stats_to_json(st, timings);
     j["scene"] = args.scene;
     j["light_sampler"] = scene.integrator.light_sampler;
+    j["split_threshold"] = scene.integrator.split_threshold;
+    j["max_cut"] = scene.integrator.max_cut;
+    j["max_depth"] = scene.integrator.max_depth;
     j["spp"] = scene.integrator.spp;
     j["film"] = {scene.film.width, scene.film.height};
     j["lights"] = scene.lights.size();
@@ -294,6 +332,14 @@ int main(int argc, char** argv) {
                    "tree-split threshold in [0, 1] (overrides the scene; 0 never splits)")
       ->check(finite_number) // before the range: "not finite" says more than "not in range"
       ->check(CLI::Range(0.0, 1.0));
+  render->add_option("--max-cut", rargs.max_cut,
+                     fmt::format("tree-split: at most this many lights per shading point, 1 .. {} "
+                                 "(overrides the scene; default {})",
+                                 kMaxMaxCut, kDefaultMaxCut));
+  render->add_option("--max-depth", rargs.max_depth,
+                     fmt::format("Path vertices after the camera hit, 1 .. {}; 1 = direct light "
+                                 "only (overrides the scene)",
+                                 kMaxDepth));
   render->add_flag("--no-orientation", rargs.no_orientation,
                    "Tree samplers: rank clusters by energy / distance^2 only (ablation of the "
                    "orientation terms, paper Fig. 15-16)");

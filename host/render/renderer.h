@@ -82,7 +82,7 @@ struct RenderSettings {
 struct RendererOptions {
   std::string light_sampler = "tree-split"; // uniform | power | tree | tree-split | exhaustive
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD;
-  int max_cut = 64;                   // cut size cap per shading point (tree-split)
+  int max_cut = kDefaultMaxCut;       // cut size cap per shading point (tree-split)
   bool orientation_term = true;       // tree samplers: false = E / d^2 importance (ablation)
   bool all_features = false;          // compile every kernel feature (tests)
   size_t split_queue_items = 1 << 20; // split-queue capacity per wave

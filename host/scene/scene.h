@@ -3,7 +3,8 @@
 // docs/scene-format.md.
 #pragma once
 
-#include "types.h" // cl/types.h: Light, Material (device layouts)
+#include "light_tree_math.h" // LT_DEFAULT_SPLIT_THRESHOLD
+#include "types.h"           // cl/types.h: Light, Material (device layouts)
 
 #include <cstdint>
 #include <filesystem>
@@ -25,6 +26,11 @@ inline constexpr uint64_t kMaxMtlFileBytes = uint64_t(64) << 20;    // 64 MiB
 inline constexpr int kMaxPolygonVertices = 1024;                    // vertices of one OBJ face
 inline constexpr int kMaxSpp = 1 << 24;
 inline constexpr int kMaxFilmSide = 16384;
+// tree-split's cap on the lights sampled per shading point: the split queue holds max_cut items per
+// path of a wave, so a larger cap means smaller waves (docs/limits.md).
+inline constexpr int kDefaultMaxCut = 64;
+inline constexpr int kMaxMaxCut = 1 << 16;
+inline constexpr int kMaxDepth = 1024; // path vertices after the camera hit
 
 // `s` made safe to echo inside a one-line message: control characters (including NUL and C1
 // controls), invalid UTF-8 and the Unicode line/paragraph separators become \n, \t, \xHH or
@@ -53,11 +59,14 @@ struct FilmSettings {
   int height = 480; // pixels, 1 .. kMaxFilmSide
 };
 
+// Defaults show the renderer at its best: the light tree with adaptive splitting at the threshold
+// docs/results.md measures best, and paths of pbrt-v4's default depth.
 struct IntegratorSettings {
   int spp = 16;      // samples per pixel, 1 .. kMaxSpp
-  int max_depth = 1; // path vertices after the camera hit: 1 = direct light only
-  std::string light_sampler = "uniform"; // uniform | power | tree | tree-split | exhaustive
-  float split_threshold = 0.85f;         // adaptive splitting threshold in [0, 1]
+  int max_depth = 5; // path vertices after the camera hit: 1 = direct light only
+  std::string light_sampler = "tree-split"; // uniform | power | tree | tree-split | exhaustive
+  float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD; // adaptive splitting threshold in [0, 1]
+  int max_cut = kDefaultMaxCut; // tree-split: at most this many lights per shading point
   uint32_t seed = 1;
 };
 
