@@ -385,7 +385,8 @@ TEST(LightTreeSampling, SplitBudgetReachesTheNearestLights) {
       lights.push_back(make_point_light(make_float3(float(x) + 0.5f * lt_rng_next(&jitter), 0.0f,
                                                     float(y) + 0.5f * lt_rng_next(&jitter)),
                                         make_float3(1, 1, 1)));
-  LightSamplerOptions o; // the default threshold (0.85) and cap (64)
+  LightSamplerOptions o; // the default cap (64) and the paper's threshold, which splits more
+  o.split_threshold = 0.85f;
   auto split = make_light_sampler("tree-split", lights, o);
   ASSERT_GE(split->tree()->levels, 6);
   int reached = 0;
