@@ -373,9 +373,9 @@ TEST(LightTreeSampling, EstimatorsAreUnbiased) {
 }
 
 // Budgets go where splitting continues (lt_child_budgets): at a shading point next to one of 10^4
-// lights, splitting with the default threshold and cap must reach that light itself (pmf 1: it is
-// in the cut), while the cut stays within the cap. An even share of the budget would stop three
-// 4-wide levels down, at clusters of ~160 lights.
+// lights, splitting with the paper's threshold and the default cap must reach that light itself
+// (pmf 1: it is in the cut), while the cut stays within the cap. An even share of the budget would
+// stop three 4-wide levels down, at clusters of ~160 lights.
 TEST(LightTreeSampling, SplitBudgetReachesTheNearestLights) {
   // 10^4 point lights on a jittered 100 x 100 grid in a plane (the spiral scene's situation)
   std::vector<Light> lights;
