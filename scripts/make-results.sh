@@ -39,8 +39,9 @@ spiral-10k | 0.25 | 20 | tree  | 1024 | 0
 cornell-1m | 0.5  | 20 | power | 2048 | 1
 city       | 0.5  | 20 | tree  | 1024 | 0
 mesh-light | 0.75 | 20 | tree  | 768  | 0
+plane-10k  | 1    | 20 | tree  | 1024 | 0
 "
-SCENES=${SCENES:-"spiral-10k cornell-1m city mesh-light"}
+SCENES=${SCENES:-"spiral-10k cornell-1m city mesh-light plane-10k"}
 
 has_heatmap=0
 if "$CANOPY" render --help 2>/dev/null | grep -q -- "--heatmap"; then has_heatmap=1; fi

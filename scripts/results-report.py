@@ -21,7 +21,11 @@ SCENES = [
     ("cornell-1m", "Cornell box with 10^6 ceiling lights (paper Fig. 17)"),
     ("city", "Procedural city, about 3 x 10^5 lights, one indirect bounce (paper Fig. 1 and 14)"),
     ("mesh-light", "Toroidal mesh light, 5,120 emissive triangles (paper Fig. 6, 15, 16)"),
+    ("plane-10k", "10,000 point lights over a diffuse plane (pbrt-v4's many-light test; "
+                  "scripts/gen-plane-lights.py)"),
 ]
+# The default split threshold (LT_DEFAULT_SPLIT_THRESHOLD in cl/light_tree_math.h).
+DEFAULT_THRESHOLD = "tree-split:0.25"
 THRESHOLDS = ["tree-split:0.0", "tree-split:0.25", "tree-split:0.5", "tree-split:0.85", "tree-split:0.95"]
 
 
@@ -245,6 +249,32 @@ def main():
                      f"| {'yes' if ok else 'no'} |")
             if label == s.best_split():
                 break
+    o.append("")
+
+    # ------------------------------------------------------------------ issue 10
+    o.append("## Targets (issue 10)\n")
+    o.append("| scene | target | measured | met |")
+    o.append("|---|---|---|---|")
+    s = scenes.get("cornell-1m")
+    if s:
+        r = s.ratio("tree", "power")
+        o.append(f"| cornell-1m | tree at least as good as power at equal time | tree/power "
+                 f"{r:.2f}× | {'yes' if r <= 1.0 else 'no'} |")
+    else:
+        o.append("| cornell-1m | tree at least as good as power at equal time | not run | no |")
+    # The default threshold: the one whose equal-time RMSE, relative to each scene's best
+    # threshold, has the smallest geometric mean over the scenes.
+    cands = [t for t in THRESHOLDS if all(t in sc.eq for sc in scenes.values())]
+    if scenes and cands:
+        def gmean_rel(t):
+            logs = [math.log(sc.eq[t][0] / sc.eq[sc.best_split()][0]) for sc in scenes.values()]
+            return math.exp(sum(logs) / len(logs))
+        best = min(cands, key=gmean_rel)
+        o.append(f"| all | the default threshold ({DEFAULT_THRESHOLD.split(':')[1]}) has the lowest "
+                 f"equal-time RMSE over the scenes (geometric mean of RMSE / the scene's best "
+                 f"threshold's) | " + ", ".join(f"{t.split(':')[1]}: {gmean_rel(t):.3f}"
+                                                 for t in cands) +
+                 f" | {'yes' if best == DEFAULT_THRESHOLD else 'no (best ' + best + ')'} |")
     o.append("")
 
     # ------------------------------------------------------------------ claims
