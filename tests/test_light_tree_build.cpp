@@ -124,7 +124,10 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
             << "light " << l;
       }
       // cone covers the light's cone (axis decoded as the traversal decodes it)
-      double co = lane(code, LT_COS_O, k);
+      // a lane with a half-space bound (LT_PLANE_FLAG) has theta_o = LT_PLANE_SLOPE,
+      // theta_e = pi/2 (its 16 bits hold the plane offset)
+      const bool plane = lane(code, LT_COS_O, k) > 1.5f;
+      double co = plane ? double(LT_PLANE_COS_O) : double(lane(code, LT_COS_O, k));
       if (co > -1.0) {
         float4 ax, ay, az;
         float4 bits = t.nodes[size_t(code) * LT_NODE_F4 + LT_AXIS];
@@ -133,8 +136,9 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
         double need = angle_d(axis, b.cone.axis) + b.cone.theta_o;
         ASSERT_LE(need, std::acos(std::clamp(co, -1.0, 1.0)) + 1e-5) << "light " << l;
       }
-      double ce = f4_get(lt_lo16_4(t.nodes[size_t(code) * LT_NODE_F4 + LT_CE_CV2]), k) *
-                  double(LT_U16_SCALE);
+      double ce = plane ? 0.0
+                        : f4_get(lt_lo16_4(t.nodes[size_t(code) * LT_NODE_F4 + LT_CE_CV2]), k) *
+                              double(LT_U16_SCALE);
       ASSERT_LE(ce, std::cos(double(b.cone.theta_e)) + 1e-6);
       ASSERT_GE(lane(code, LT_ENERGY, k), b.energy * (1 - 1e-6));
       code = c;
@@ -151,7 +155,11 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
     ASSERT_EQ(rec[0].w, sp.w);
     ASSERT_EQ(rec[1].z, float(b.energy));
     float q = rec[1].y;
-    double rco = q > 1.5f ? 1.0 : double(q), rce = q > 1.5f ? double(q) - 2.0 : 0.0;
+    double rco = q > 1.5f ? 1.0 : (q < -1.5f ? double(LT_PLANE_COS_O) : double(q));
+    double rce = q > 1.5f ? double(q) - 2.0 : 0.0;
+    if (q < -1.5f) {
+      ASSERT_GE(b.plane_h, 0.0) << "light " << l; // one-sided planar only
+    }
     ASSERT_LE(rce, std::cos(double(b.cone.theta_e)) + 1e-7) << "light " << l;
     if (rco > -1.0) {
       float4 ax, ay, az;

@@ -33,6 +33,12 @@ struct EmitterBounds {
   LtCone cone; // axis, theta_o, theta_e
   double energy;
   float cos_o, cos_e; // the cone as lt_light_bounds gives it (cosines, exact)
+  // One-sided planar emitters (quad, triangle; not two-sided, with a normal): the largest
+  // dot(n, c - x) over its vertices x (n = cone.axis, c = the centre of lt_sphere_of_box(bmin,
+  // bmax)) plus a margin for the float rounding of its sample and hit points, so every point
+  // the renderer can sample on it lies on the front side of the plane through c - plane_h n.
+  // -1 for every other emitter (no half-space bound).
+  double plane_h = -1.0;
 };
 EmitterBounds emitter_bounds(const Light& light);
 std::vector<EmitterBounds> emitter_bounds(const std::vector<Light>& lights); // parallel
