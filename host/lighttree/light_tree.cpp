@@ -6,6 +6,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cfloat>
 #include <cmath>
@@ -273,19 +274,13 @@ public:
       return;
     }
     // Small clusters (at most kPackLeaves leaves' worth, 64 emitters) are packed into as few full
-    // leaves as possible: median splits along the widest centroid axis into multiples of
-    // leaf_size (halving the number of leaves). Fuller leaves and fuller 4-wide nodes keep the
-    // tree with its emitter records under 64 bytes/emitter, and skip the SAOH binning where it
-    // matters least (the emitters of a leaf are ranked individually by their records anyway).
+    // leaves as possible: every split puts a multiple of leaf_size emitters on the left, so all
+    // leaves but one are full. Fuller leaves and fuller 4-wide nodes keep the tree with its
+    // emitter records under 64 bytes/emitter. Among those splits, the SAOH cost (Eq. 2, exact
+    // sweeps over the emitters sorted along each axis) chooses, so small clusters are split by
+    // orientation too (the paper's Fig. 5 roof of 32 triangles: one slope per child).
     if (n <= kPackLeaves * opt_.leaf_size && similar_energies(begin, end)) {
-      int leaves = (n + opt_.leaf_size - 1) / opt_.leaf_size;
-      int m = begin + opt_.leaf_size * ((leaves + 1) / 2);
-      float3 ce = acc.cmax - acc.cmin;
-      if (ce.x > 0 || ce.y > 0 || ce.z > 0) {
-        int a = ce.x >= ce.y && ce.x >= ce.z ? 0 : (ce.y >= ce.z ? 1 : 2);
-        std::nth_element(prims_.data() + begin, prims_.data() + m, prims_.data() + end,
-                         [a](const Prim& p, const Prim& q) { return comp(p.c, a) < comp(q.c, a); });
-      }
+      int m = pack_split(begin, end, depth, acc);
       recurse(ni, begin, m, end, depth, reduce_range(prims_.data(), begin, m),
               reduce_range(prims_.data(), m, end));
       return;
@@ -378,6 +373,78 @@ public:
   }
 
 private:
+  // The packing split of a cluster of at most kPackLeaves * leaf_size emitters (see build): the
+  // left child gets leaf_size * j emitters, j chosen with the axis by the least SAOH cost, among
+  // the j whose children still fit the bit-trail depth (ceil(log2(leaves)) more levels each).
+  // Reorders prims_[begin, end) along the chosen axis and returns the split index.
+  int pack_split(int begin, int end, int depth, const Acc& acc) {
+    const int n = end - begin, ls = opt_.leaf_size;
+    const int leaves = (n + ls - 1) / ls;
+    const int balanced = begin + ls * ((leaves + 1) / 2);
+    const float3 cext = acc.cmax - acc.cmin;
+    if (!(cext.x > 0 || cext.y > 0 || cext.z > 0)) return balanced; // coincident centroids
+    const int room = kMaxBinaryDepth - depth - 1;                   // levels below each child
+    auto fits = [&](int count) {
+      int lv = (count + ls - 1) / ls, need = 0;
+      while ((1 << need) < lv)
+        ++need;
+      return need <= room;
+    };
+    const float3 ext = acc.bmax - acc.bmin;
+    const float lmax = std::max({ext.x, ext.y, ext.z});
+    const float delta = 1e-3f * lmax;
+    Prim* p = prims_.data() + begin;
+    auto sort_axis = [&](int a) {
+      std::sort(p, p + n, [a](const Prim& x, const Prim& y) {
+        float cx = comp(x.c, a), cy = comp(y.c, a);
+        return cx < cy || (cx == cy && x.id < y.id);
+      });
+    };
+    std::array<Acc, kPackLeaves + 1> left; // left[j]: the first ls * j emitters
+    double best = INFINITY;
+    int best_axis = -1, best_j = 0, sorted = -1;
+    for (int a = 0; a < 3; ++a) {
+      const float len = comp(ext, a);
+      if (!(comp(cext, a) > 0) || !(len > 0)) continue;
+      sort_axis(a);
+      sorted = a;
+      left[0] = Acc();
+      for (int j = 1; j < leaves; ++j) {
+        left[j] = left[j - 1];
+        for (int i = ls * (j - 1); i < ls * j; ++i)
+          left[j].add(p[i]);
+      }
+      const double kr = double(lmax) / double(len);
+      Acc right;
+      int i = n;
+      for (int j = leaves - 1; j >= 1; --j) {
+        for (; i > ls * j; --i)
+          right.add(p[i - 1]);
+        const Acc& l = left[j];
+        if (!fits(l.count) || !fits(right.count)) continue;
+        const double wl = acc.e > 0 ? l.e : double(l.count);
+        const double wr = acc.e > 0 ? right.e : double(right.count);
+        const double cost =
+            kr * (wl * area_measure(l.bmin, l.bmax, delta) * m_omega(l.cone) +
+                  wr * area_measure(right.bmin, right.bmax, delta) * m_omega(right.cone));
+        if (cost < best) {
+          best = cost;
+          best_axis = a;
+          best_j = j;
+        }
+      }
+    }
+    if (best_axis < 0) { // no axis with extent (or no fitting split): the balanced median
+      if (sorted < 0) {
+        int a = cext.x >= cext.y && cext.x >= cext.z ? 0 : (cext.y >= cext.z ? 1 : 2);
+        sort_axis(a);
+      }
+      return balanced;
+    }
+    if (sorted != best_axis) sort_axis(best_axis);
+    return begin + ls * best_j;
+  }
+
   void recurse(int ni, int begin, int mid, int end, int depth, const Acc& l, const Acc& r) {
     int li = next.fetch_add(2);
     nodes_[ni].left = li;
