@@ -94,7 +94,7 @@
 #define LT_PLANE_COS_O 0.99999994f    /* cos(2^-12) rounded down */
 #define LT_PLANE_NONE 3.0e38f         /* h of a lane without a plane: never culls */
 // Node lanes with a plane: LT_COS_O holds LT_PLANE_FLAG (> 1, no cosine) and the low 16 bits of
-// LT_CE_CV2 hold k, h = k * (r * LT_PLANE_H_UNIT) (theta_e = pi/2 needs no bits).
+// LT_CE_CV2 hold k, h = (k - 32768) * (r * LT_PLANE_H_UNIT) (theta_e = pi/2 needs no bits).
 #define LT_PLANE_FLAG 2.0f
 #define LT_PLANE_H_UNIT 6.1035156e-05f /* 2^-14 */
 
@@ -893,7 +893,8 @@ LT_HOT float4 lt_node_importance_f(const LtTree* t, int node, float3 P, float3 N
   lt_vm4 plane = lt_vgt(cos_o, lt_vs(1.5f)); // LT_PLANE_FLAG: k16 is the plane offset
   lt_v4 cos_e = lt_vsel(lt_vmul(k16, lt_vs(LT_U16_SCALE)), lt_vs(0.0f), plane);
   lt_v4 plane_h =
-      lt_vsel(lt_vs(LT_PLANE_NONE), lt_vmul(k16, lt_vmul(r, lt_vs(LT_PLANE_H_UNIT))), plane);
+      lt_vsel(lt_vs(LT_PLANE_NONE),
+              lt_vmul(lt_vsub(k16, lt_vs(32768.0f)), lt_vmul(r, lt_vs(LT_PLANE_H_UNIT))), plane);
   cos_o = lt_vsel(cos_o, lt_vs(LT_PLANE_COS_O), plane);
   lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
   return lt_fv(lt_importance_v(lt_vld(n + LT_CX), lt_vld(n + LT_CY), lt_vld(n + LT_CZ), r, ax, ay,

@@ -280,9 +280,9 @@ public:
     // sweeps over the emitters sorted along each axis) chooses, so small clusters are split by
     // orientation too (the paper's Fig. 5 roof of 32 triangles: one slope per child).
     if (n <= kPackLeaves * opt_.leaf_size && similar_energies(begin, end)) {
-      int m = pack_split(begin, end, depth, acc);
-      recurse(ni, begin, m, end, depth, reduce_range(prims_.data(), begin, m),
-              reduce_range(prims_.data(), m, end));
+      Acc l, r;
+      int m = pack_split(begin, end, depth, acc, &l, &r);
+      recurse(ni, begin, m, end, depth, l, r);
       return;
     }
     // Child capacity at depth + 1 so every leaf ends at binary depth <= kMaxBinaryDepth.
@@ -374,16 +374,46 @@ public:
 
 private:
   // The packing split of a cluster of at most kPackLeaves * leaf_size emitters (see build): the
-  // left child gets leaf_size * j emitters, j chosen with the axis by the least SAOH cost, among
-  // the j whose children still fit the bit-trail depth (ceil(log2(leaves)) more levels each).
-  // Reorders prims_[begin, end) along the chosen axis and returns the split index.
-  int pack_split(int begin, int end, int depth, const Acc& acc) {
+  // left child gets leaf_size * j emitters. Where the emitters' cones differ, j and the axis are
+  // chosen by the least SAOH cost among the j whose children still fit the bit-trail depth
+  // (ceil(log2(leaves)) more levels each); the sweeps accumulate whole leaves' worth of emitters
+  // (chunks), then merge chunks. Where every cone is the same (or every one is the full sphere,
+  // e.g. point lights), M_Omega is the same for every child and the split is the balanced median
+  // along the widest centroid axis, as fast as before. Reorders prims_[begin, end), returns the
+  // split index and the children's accumulators.
+  int pack_split(int begin, int end, int depth, const Acc& acc, Acc* lo, Acc* hi) {
     const int n = end - begin, ls = opt_.leaf_size;
     const int leaves = (n + ls - 1) / ls;
-    const int balanced = begin + ls * ((leaves + 1) / 2);
+    int m = begin + ls * ((leaves + 1) / 2);
     const float3 cext = acc.cmax - acc.cmin;
-    if (!(cext.x > 0 || cext.y > 0 || cext.z > 0)) return balanced; // coincident centroids
-    const int room = kMaxBinaryDepth - depth - 1;                   // levels below each child
+    Prim* p = prims_.data() + begin;
+    auto sort_axis = [&](int a) {
+      std::sort(p, p + n, [a](const Prim& x, const Prim& y) {
+        float cx = comp(x.c, a), cy = comp(y.c, a);
+        return cx < cy || (cx == cy && x.id < y.id);
+      });
+    };
+    auto median = [&] {
+      if (cext.x > 0 || cext.y > 0 || cext.z > 0) {
+        int a = cext.x >= cext.y && cext.x >= cext.z ? 0 : (cext.y >= cext.z ? 1 : 2);
+        std::nth_element(p, prims_.data() + m, p + n,
+                         [a](const Prim& x, const Prim& y) { return comp(x.c, a) < comp(y.c, a); });
+      }
+      *lo = reduce_range(prims_.data(), begin, m);
+      *hi = reduce_range(prims_.data(), m, end);
+      return m;
+    };
+    bool all_full = true, all_same = true;
+    const HCone& c0 = p[0].cone;
+    for (int i = 0; i < n; ++i) {
+      const HCone& c = p[i].cone;
+      all_full = all_full && c.to >= kPi;
+      all_same = all_same && c.to == c0.to && c.te == c0.te && c.axis.x == c0.axis.x &&
+                 c.axis.y == c0.axis.y && c.axis.z == c0.axis.z;
+    }
+    if (all_full || all_same || !(cext.x > 0 || cext.y > 0 || cext.z > 0)) return median();
+
+    const int room = kMaxBinaryDepth - depth - 1; // levels below each child
     auto fits = [&](int count) {
       int lv = (count + ls - 1) / ls, need = 0;
       while ((1 << need) < lv)
@@ -393,14 +423,7 @@ private:
     const float3 ext = acc.bmax - acc.bmin;
     const float lmax = std::max({ext.x, ext.y, ext.z});
     const float delta = 1e-3f * lmax;
-    Prim* p = prims_.data() + begin;
-    auto sort_axis = [&](int a) {
-      std::sort(p, p + n, [a](const Prim& x, const Prim& y) {
-        float cx = comp(x.c, a), cy = comp(y.c, a);
-        return cx < cy || (cx == cy && x.id < y.id);
-      });
-    };
-    std::array<Acc, kPackLeaves + 1> left; // left[j]: the first ls * j emitters
+    std::array<Acc, kPackLeaves + 1> left, right; // the first / last chunks up to chunk j
     double best = INFINITY;
     int best_axis = -1, best_j = 0, sorted = -1;
     for (int a = 0; a < 3; ++a) {
@@ -408,39 +431,36 @@ private:
       if (!(comp(cext, a) > 0) || !(len > 0)) continue;
       sort_axis(a);
       sorted = a;
+      for (int j = 0; j < leaves; ++j) { // right[j]: chunk j alone for now
+        right[j] = Acc();
+        for (int i = ls * j; i < std::min(n, ls * (j + 1)); ++i)
+          right[j].add(p[i]);
+      }
       left[0] = Acc();
       for (int j = 1; j < leaves; ++j) {
         left[j] = left[j - 1];
-        for (int i = ls * (j - 1); i < ls * j; ++i)
-          left[j].add(p[i]);
+        left[j].merge(right[j - 1]);
       }
+      for (int j = leaves - 2; j >= 1; --j)
+        right[j].merge(right[j + 1]); // right[j]: chunks j .. leaves - 1
       const double kr = double(lmax) / double(len);
-      Acc right;
-      int i = n;
-      for (int j = leaves - 1; j >= 1; --j) {
-        for (; i > ls * j; --i)
-          right.add(p[i - 1]);
-        const Acc& l = left[j];
-        if (!fits(l.count) || !fits(right.count)) continue;
+      for (int j = 1; j < leaves; ++j) {
+        const Acc &l = left[j], &r = right[j];
+        if (!fits(l.count) || !fits(r.count)) continue;
         const double wl = acc.e > 0 ? l.e : double(l.count);
-        const double wr = acc.e > 0 ? right.e : double(right.count);
-        const double cost =
-            kr * (wl * area_measure(l.bmin, l.bmax, delta) * m_omega(l.cone) +
-                  wr * area_measure(right.bmin, right.bmax, delta) * m_omega(right.cone));
+        const double wr = acc.e > 0 ? r.e : double(r.count);
+        const double cost = kr * (wl * area_measure(l.bmin, l.bmax, delta) * m_omega(l.cone) +
+                                  wr * area_measure(r.bmin, r.bmax, delta) * m_omega(r.cone));
         if (cost < best) {
           best = cost;
           best_axis = a;
           best_j = j;
+          *lo = l;
+          *hi = r;
         }
       }
     }
-    if (best_axis < 0) { // no axis with extent (or no fitting split): the balanced median
-      if (sorted < 0) {
-        int a = cext.x >= cext.y && cext.x >= cext.z ? 0 : (cext.y >= cext.z ? 1 : 2);
-        sort_axis(a);
-      }
-      return balanced;
-    }
+    if (best_axis < 0) return median(); // no split fits the depth: the balanced median
     if (sorted != best_axis) sort_axis(best_axis);
     return begin + ls * best_j;
   }
@@ -526,10 +546,10 @@ namespace {
 double plane_offset(const Light& l, const EmitterBounds& b) {
   if ((l.type != LIGHT_QUAD && l.type != LIGHT_TRIANGLE) || (l.flags & LIGHT_FLAG_TWO_SIDED) ||
       b.cos_o < 1.0f)
-    return -1.0;
+    return NAN;
   const double nl =
       std::sqrt(double(l.n.x) * l.n.x + double(l.n.y) * l.n.y + double(l.n.z) * l.n.z);
-  if (!(nl > 0) || !std::isfinite(nl)) return -1.0; // no emitting side
+  if (!(nl > 0) || !std::isfinite(nl)) return NAN; // no emitting side
   const float3 n = b.cone.axis;
   const float4 c = lt_sphere_of_box(b.bmin, b.bmax);
   const double p[3] = {l.p.x, l.p.y, l.p.z}, e1[3] = {l.e1.x, l.e1.y, l.e1.z},
@@ -547,7 +567,7 @@ double plane_offset(const Light& l, const EmitterBounds& b) {
   for (int k = 0; k < 3; ++k)
     norm1 += std::fabs(p[k]) + std::fabs(e1[k]) + std::fabs(e2[k]);
   h += std::ldexp(norm1, -20);
-  return std::isfinite(h) ? std::max(h, 0.0) : -1.0;
+  return std::isfinite(h) ? h : NAN;
 }
 } // namespace
 
@@ -739,10 +759,11 @@ void emitter_record(const EmitterBounds& b, int light, float4* rec) {
   double te = b.cos_e <= 0.0f ? M_PI / 2 : std::acos(double(b.cos_e));
   const float r = rec[0].w;
   float q;
-  if (b.plane_h >= 0.0 && r > 0.0f && pad <= kPlaneAngle) {
+  if (!std::isnan(b.plane_h) && r > 0.0f && pad <= kPlaneAngle) {
     // dot(n, P - x) = dot(n, P - c) + dot(n, c - x) <= dot(a, P - c) + |n - a| |P - c| + plane_h,
     // and |n - a| <= pad <= kPlaneAngle: the middle term is within LT_PLANE_SLOPE |P - c|.
-    const double h = b.plane_h;
+    // q < -1.5 flags the bound: h > -r / 2 (h >= -r always; a larger h only culls less)
+    const double h = std::max(b.plane_h, -0.49 * double(r));
     q = float_down(-2.0 - h / double(r));
     while (std::isfinite(q) && double((-2.0f - q) * r) < h)
       q = std::nextafter(q, -FLT_INF);
@@ -779,8 +800,8 @@ struct Collapser {
   //   dot(a, P - x) = dot(a, P - c) + dot(a, c - c_i) + dot(a, c_i - x),
   //   dot(a, c_i - x) <= dot(n_i, c_i - x) + |a - n_i| r_i <= plane_h_i + |a - n_i| r_i,
   // so h = max_i [dot(a, c - c_i) + plane_h_i + |n_i - a| (r_i + r)] and |n_i - a| |P - c| is
-  // within LT_PLANE_SLOPE |P - c|. Returns the 16-bit k with k * (r * LT_PLANE_H_UNIT) >= h (as
-  // the device computes it), or -1 if the lane gets no bound.
+  // within LT_PLANE_SLOPE |P - c|. Returns the 16-bit k with (k - 32768) * (r * LT_PLANE_H_UNIT)
+  // >= h (as the device computes it), or -1 if the lane gets no bound.
   int plane_code(const BinaryLightNode& s, float4 sp, uint32_t oct) const {
     if (!(sp.w > 0.0f) || !(s.cone.theta_o <= 2.0 * kPlaneAngle)) return -1;
     const float3 a = oct_decode(oct);
@@ -788,7 +809,7 @@ struct Collapser {
     double h = -INFINITY, scale = std::fabs(sp.x) + std::fabs(sp.y) + std::fabs(sp.z);
     for (int i = s.first; i < s.first + s.count; ++i) {
       const EmitterBounds& e = eb[size_t(bt.order[size_t(i)])];
-      if (!(e.plane_h >= 0.0)) return -1;
+      if (std::isnan(e.plane_h)) return -1;
       const double ch = chord(a, e.cone.axis);
       if (chord_angle(ch) > kPlaneAngle) return -1;
       const float4 ci = lt_sphere_of_box(e.bmin, e.bmax);
@@ -798,10 +819,11 @@ struct Collapser {
       scale = std::max(scale, double(std::fabs(ci.x) + std::fabs(ci.y) + std::fabs(ci.z)));
     }
     h += std::ldexp(scale, -40); // the double rounding of the dot products
+    // signed: h = (k - 32768) * (r * 2^-14), in [-2r, 2r) (|h| <= r up to the margins)
     const float unit = sp.w * LT_PLANE_H_UNIT;
-    double k = std::ceil(std::max(h, 0.0) / double(unit));
+    double k = std::ceil(std::max(h / double(unit), -32768.0)) + 32768.0;
     if (!(k <= 65535.0)) return -1;
-    while (k <= 65535.0 && double(float(k) * unit) < h)
+    while (k <= 65535.0 && double((float(k) - 32768.0f) * unit) < h)
       k += 1.0;
     return k <= 65535.0 ? int(k) : -1;
   }

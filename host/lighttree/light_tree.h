@@ -18,6 +18,7 @@
 
 #include "light_tree_math.h" // cl/: LtCone, LtTree, layout constants
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -36,9 +37,10 @@ struct EmitterBounds {
   // One-sided planar emitters (quad, triangle; not two-sided, with a normal): the largest
   // dot(n, c - x) over its vertices x (n = cone.axis, c = the centre of lt_sphere_of_box(bmin,
   // bmax)) plus a margin for the float rounding of its sample and hit points, so every point
-  // the renderer can sample on it lies on the front side of the plane through c - plane_h n.
-  // -1 for every other emitter (no half-space bound).
-  double plane_h = -1.0;
+  // the renderer can sample on it lies on the front side of the plane through c - plane_h n
+  // (negative when c is behind that plane, e.g. the box centre of a tilted triangle). NaN for
+  // every other emitter (no half-space bound).
+  double plane_h = NAN;
 };
 EmitterBounds emitter_bounds(const Light& light);
 std::vector<EmitterBounds> emitter_bounds(const std::vector<Light>& lights); // parallel
