@@ -12,10 +12,14 @@
 //   nodes[n*8 + 4]     LT_AXIS               orientation cone axis, octahedral, 2 x 16 bits (the
 //                                            bits of the float; lt_oct_decode_v)
 //   nodes[n*8 + 5]     LT_COS_O              cos(theta_o) (normal bound), widened by the axis
-//                                            quantisation error and rounded down
+//                                            quantisation error and rounded down; LT_PLANE_FLAG
+//                                            (2): a lane of one-sided planar emitters with a
+//                                            half-space bound, theta_o = LT_PLANE_SLOPE
 //   nodes[n*8 + 6]     LT_ENERGY             sum of emitter energies (luminance of max intensity)
 //   nodes[n*8 + 7]     LT_CE_CV2             bits 0-15: cos(theta_e) * 65535 rounded down
-//                                            (emission bound, theta_e <= pi/2); bits 16-31: the
+//                                            (emission bound, theta_e <= pi/2), or for a
+//                                            LT_PLANE_FLAG lane (theta_e = pi/2) the plane offset
+//                                            k: h = (k - 32768) r 2^-14; bits 16-31: the
 //                                            high half of the float V[e]/E[e]^2 (squared
 //                                            coefficient of variation of the energies, splitting)
 //   children[n].lane   >= 0: index of a child node (the child nodes of a node are consecutive)
@@ -27,8 +31,10 @@
 // lt_emitter_base() (root_info.z holds its bits plus LT_EMITTER_BASE_BIAS):
 //   record[0]  bounding sphere of the emitter (centre, radius), as in the nodes
 //   record[1]  x: octahedral axis bits; y: cone q (q <= 1: cos(theta_o), theta_e = pi/2; q > 1.5:
-//              theta_o = 0, cos(theta_e) = q - 2; widened by the axis quantisation error);
-//              z: energy; w: bits of the light index (= leaf_lights[first + j])
+//              theta_o = 0, cos(theta_e) = q - 2; widened by the axis quantisation error;
+//              q < -1.5: one-sided planar, theta_o = LT_PLANE_SLOPE, theta_e = pi/2, half-space
+//              bound h = (-2 - q) r); z: energy; w: bits of the light index
+//              (= leaf_lights[first + j])
 // so a leaf is ranked from its records without touching the scene's Light buffer. The tree costs
 // 52-61 bytes/emitter. trails[light]: the light's bit-trail, 2 bits per 4-wide level starting with
 // the root in the two lowest bits, then 2 bits for its index inside its leaf. root_sphere /
