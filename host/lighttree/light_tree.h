@@ -5,8 +5,10 @@
 // Device layout (upload each vector as one buffer, as is; see the top of cl/light_tree_math.h):
 //   nodes        float4 x LT_NODE_F4 (8) per 4-wide node: per-lane sphere centre x/y/z, radius,
 //                octahedral cone axis, cos(theta_o), energy, cos(theta_e) | energy CV^2 (16 bits
-//                each); then LT_EMITTER_F4 (2) float4 per emitter in leaf order (emitter records:
-//                sphere; axis, cone, energy, light index)
+//                each; lanes of one-sided planar emitters flag a half-space bound in cos(theta_o)
+//                and keep its offset in the cos(theta_e) bits); then LT_EMITTER_F4 (2) float4 per
+//                emitter in leaf order (emitter records: sphere; axis, cone or plane offset,
+//                energy, light index)
 //   children     int4 per node: child node index, LT_EMPTY, or a leaf code (lt_leaf_code)
 //   leaf_lights  int per emitter, light indices in leaf order (leaves are contiguous ranges)
 //   trails       uint per light index: bit-trail, 2 bits per level from the root, then 2 bits for
