@@ -12,10 +12,14 @@
 //   nodes[n*8 + 4]     LT_AXIS               orientation cone axis, octahedral, 2 x 16 bits (the
 //                                            bits of the float; lt_oct_decode_v)
 //   nodes[n*8 + 5]     LT_COS_O              cos(theta_o) (normal bound), widened by the axis
-//                                            quantisation error and rounded down
+//                                            quantisation error and rounded down; LT_PLANE_FLAG
+//                                            (2): a lane of one-sided planar emitters with a
+//                                            half-space bound, theta_o = LT_PLANE_SLOPE
 //   nodes[n*8 + 6]     LT_ENERGY             sum of emitter energies (luminance of max intensity)
 //   nodes[n*8 + 7]     LT_CE_CV2             bits 0-15: cos(theta_e) * 65535 rounded down
-//                                            (emission bound, theta_e <= pi/2); bits 16-31: the
+//                                            (emission bound, theta_e <= pi/2), or for a
+//                                            LT_PLANE_FLAG lane (theta_e = pi/2) the plane offset
+//                                            k: h = (k - 32768) r 2^-14; bits 16-31: the
 //                                            high half of the float V[e]/E[e]^2 (squared
 //                                            coefficient of variation of the energies, splitting)
 //   children[n].lane   >= 0: index of a child node (the child nodes of a node are consecutive)
@@ -27,8 +31,10 @@
 // lt_emitter_base() (root_info.z holds its bits plus LT_EMITTER_BASE_BIAS):
 //   record[0]  bounding sphere of the emitter (centre, radius), as in the nodes
 //   record[1]  x: octahedral axis bits; y: cone q (q <= 1: cos(theta_o), theta_e = pi/2; q > 1.5:
-//              theta_o = 0, cos(theta_e) = q - 2; widened by the axis quantisation error);
-//              z: energy; w: bits of the light index (= leaf_lights[first + j])
+//              theta_o = 0, cos(theta_e) = q - 2; widened by the axis quantisation error;
+//              q < -1.5: one-sided planar, theta_o = LT_PLANE_SLOPE, theta_e = pi/2, half-space
+//              bound h = (-2 - q) r); z: energy; w: bits of the light index
+//              (= leaf_lights[first + j])
 // so a leaf is ranked from its records without touching the scene's Light buffer. The tree costs
 // 52-61 bytes/emitter. trails[light]: the light's bit-trail, 2 bits per 4-wide level starting with
 // the root in the two lowest bits, then 2 bits for its index inside its leaf. root_sphere /
@@ -80,6 +86,23 @@
 #define LT_BUDGET_UNLIMITED 0x7fffffffu
 // Default threshold of the adaptive split (see lt_split_measure for its meaning and calibration).
 #define LT_DEFAULT_SPLIT_THRESHOLD 0.25f
+// Half-space bound of one-sided planar emitters (quads, triangles, mesh triangles): such an emitter
+// sends nothing to a point on or behind its plane. A lane with a plane offset h (the emitters of
+// the lane all lie on the front side of the plane through c - h a, a = the lane's decoded axis) is
+// culled at P when dot(a, P - c) <= -(h + LT_PLANE_SLOPE |P - c|), c = the lane's sphere centre.
+// The slope covers the angle between a and every emitter's own normal (octahedral quantisation,
+// and for a node the spread of its emitters' normals: nodes qualify when it is below
+// LT_PLANE_SLOPE - LT_PLANE_ROUND) plus the float rounding of the test (LT_PLANE_ROUND, relative
+// to |P - c|); h absorbs the rest (the emitters' extent below c, the rounding of their sample
+// points). Such lanes have the cone theta_o = LT_PLANE_SLOPE, theta_e = pi/2.
+#define LT_PLANE_SLOPE 2.4414062e-04f /* 2^-12 */
+#define LT_PLANE_ROUND 3.8146973e-06f /* 2^-18 */
+#define LT_PLANE_COS_O 0.99999994f    /* cos(2^-12) rounded down */
+#define LT_PLANE_NONE 3.0e38f         /* h of a lane without a plane: never culls */
+// Node lanes with a plane: LT_COS_O holds LT_PLANE_FLAG (> 1, no cosine) and the low 16 bits of
+// LT_CE_CV2 hold k, h = (k - 32768) * (r * LT_PLANE_H_UNIT) (theta_e = pi/2 needs no bits).
+#define LT_PLANE_FLAG 2.0f
+#define LT_PLANE_H_UNIT 6.1035156e-05f /* 2^-14 */
 
 // ---------------------------------------------------------------- helper layer (4 lanes)
 #ifdef __OPENCL_C_VERSION__
@@ -672,10 +695,14 @@ INLINE float4 lt_sphere_of_box(float3 bmin, float3 bmax) {
 // sin a sin b (no acos). Emitters below the horizon of N are culled (opaque surfaces).
 // Lanes are normalised by the largest energy and the smallest clamped d^2 among the lanes (only
 // ratios matter) and a lane that can contribute gets at least LT_IMPORTANCE_FLOOR: the result is
-// never 0 for a cluster that can contribute and never overflows. If no lane can contribute, lanes
-// with energy get E/d^2 (see below); only lanes without energy are ever 0 then.
+// never 0 for a cluster that can contribute and never overflows. A lane whose half-space bound
+// (plane offset h, see LT_PLANE_SLOPE; LT_PLANE_NONE: none) puts P behind all its one-sided planar
+// emitters is 0 whatever its sphere, P inside it included. If no lane can contribute and
+// `fallback` is set (stochastic descents), lanes with energy get E/d^2 (see below); only lanes
+// without energy are ever 0 then. Without `fallback` (splitting) such lanes stay 0.
 LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt_v4 ay, lt_v4 az,
-                             lt_v4 cos_o, lt_v4 cos_e, lt_v4 energy, float3 P, float3 N) {
+                             lt_v4 cos_o, lt_v4 cos_e, lt_v4 energy, lt_v4 plane_h, float3 P,
+                             float3 N, int fallback) {
   lt_v4 zero = lt_vs(0.0f);
   lt_v4 one = lt_vs(1.0f);
   lt_v4 dx = lt_vsub(cx, lt_vs(P.x));
@@ -696,6 +723,9 @@ LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt
   // theta: angle between the cone axis and the direction from the cluster towards P
   lt_v4 cos_t = lt_vmul(
       lt_vsub(zero, lt_vadd(lt_vadd(lt_vmul(ax, dx), lt_vmul(ay, dy)), lt_vmul(az, dz))), inv_d);
+  // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
+  lt_vm4 front =
+      lt_vgt(cos_t, lt_vsub(zero, lt_vadd(lt_vmul(plane_h, inv_d), lt_vs(LT_PLANE_SLOPE))));
   lt_v4 kx = lt_vsub(lt_vmul(ay, dz), lt_vmul(az, dy));
   lt_v4 ky = lt_vsub(lt_vmul(az, dx), lt_vmul(ax, dz));
   lt_v4 kz = lt_vsub(lt_vmul(ax, dy), lt_vmul(ay, dx));
@@ -733,12 +763,12 @@ LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt
   lt_v4 g = lt_vdiv(lt_vs(dmin2), d2c);
   lt_v4 oc = lt_vmul(orient, cos_i);
   lt_v4 imp = lt_vmul(lt_vmul(e, g), oc);
-  lt_vm4 contributes = lt_vand(alive, lt_vgt(oc, zero));
+  lt_vm4 contributes = lt_vand(lt_vand(alive, lt_vgt(oc, zero)), front);
   lt_v4 res = lt_vsel(zero, lt_vmax(imp, lt_vs(LT_IMPORTANCE_FLOOR)), contributes);
   // No lane can contribute but some has energy (bounds of the parent were looser than those of
   // its children): rank by energy and distance alone, so a descent never dead-ends and the pmf
   // sums to 1 over the lights with energy. Such picks contribute 0, which keeps them unbiased.
-  if (!(lt_vsum(res) > 0.0f) && emax > 0.0f)
+  if (fallback && !(lt_vsum(res) > 0.0f) && emax > 0.0f)
     res = lt_vsel(zero, lt_vmax(lt_vmul(e, g), lt_vs(LT_IMPORTANCE_FLOOR)), alive);
   return res;
 }
@@ -746,7 +776,8 @@ LT_HOT float4 lt_importance4(float4 cx, float4 cy, float4 cz, float4 r, float4 a
                              float4 az, float4 cos_o, float4 cos_e, float4 energy, float3 P,
                              float3 N) {
   return lt_fv(lt_importance_v(lt_vf(cx), lt_vf(cy), lt_vf(cz), lt_vf(r), lt_vf(ax), lt_vf(ay),
-                               lt_vf(az), lt_vf(cos_o), lt_vf(cos_e), lt_vf(energy), P, N));
+                               lt_vf(az), lt_vf(cos_o), lt_vf(cos_e), lt_vf(energy),
+                               lt_vs(LT_PLANE_NONE), P, N, 1));
 }
 
 // ---------------------------------------------------------------- tree traversal (Alg. 2)
@@ -811,16 +842,20 @@ LT_HOT void lt_oct_decode4(float4 u, float4 v, float4* ax, float4* ay, float4* a
 }
 
 // The orientation ablation (LT_TERMS_DISTANCE): a cone of half-angle pi around any axis bounds
-// every direction (cos theta' = 1), and N = 0 drops the receiver's incidence term.
-INLINE void lt_without_orientation(const LtTree* t, lt_v4* cos_o, lt_v4* cos_e, float3* N) {
+// every direction (cos theta' = 1), N = 0 drops the receiver's incidence term, and no half-space
+// bound culls (it is an orientation term too).
+INLINE void lt_without_orientation(const LtTree* t, lt_v4* cos_o, lt_v4* cos_e, lt_v4* plane_h,
+                                   float3* N) {
   if (t->root_info.w == LT_TERMS_FULL) return;
   *cos_o = lt_vs(-1.0f);
   *cos_e = lt_vs(-1.0f);
+  *plane_h = lt_vs(LT_PLANE_NONE);
   *N = make_float3(0.0f, 0.0f, 0.0f);
 }
 
-// Importance of the (up to four) emitters of a leaf, from their emitter records.
-LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) {
+// Importance of the (up to four) emitters of a leaf, from their emitter records (`fallback`: see
+// lt_importance_v).
+LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N, int fallback) {
   int count = lt_leaf_count(code);
   GLOBAL const float4* e = lt_emitter_records(t, lt_leaf_first(code));
   lt_v4 zero = lt_vs(0.0f);
@@ -843,28 +878,46 @@ LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) 
   lt_v4 ax, ay, az;
   lt_oct_decode_v(lt_vlo16(b0), lt_vhi16(b0), &ax, &ay, &az);
   lt_vm4 spot = lt_vgt(b1, lt_vs(1.5f));
-  lt_v4 cos_o = lt_vsel(b1, lt_vs(1.0f), spot);
+  lt_vm4 plane = lt_vlt(b1, lt_vs(-1.5f)); // one-sided planar: q = -2 - h / r
+  lt_v4 cos_o = lt_vsel(lt_vsel(b1, lt_vs(1.0f), spot), lt_vs(LT_PLANE_COS_O), plane);
   lt_v4 cos_e = lt_vsel(zero, lt_vsub(b1, lt_vs(2.0f)), spot);
-  lt_without_orientation(t, &cos_o, &cos_e, &N);
-  return lt_fv(lt_importance_v(a0, a1, a2, a3, ax, ay, az, cos_o, cos_e, b2, P, N));
+  lt_v4 plane_h = lt_vsel(lt_vs(LT_PLANE_NONE), lt_vmul(lt_vsub(lt_vs(-2.0f), b1), a3), plane);
+  lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
+  return lt_fv(
+      lt_importance_v(a0, a1, a2, a3, ax, ay, az, cos_o, cos_e, b2, plane_h, P, N, fallback));
+}
+LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) {
+  return lt_leaf_importance_f(t, code, P, N, 1);
 }
 
-LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) {
+LT_HOT float4 lt_node_importance_f(const LtTree* t, int node, float3 P, float3 N, int fallback) {
   GLOBAL const float4* n = t->nodes + node * LT_NODE_F4;
   lt_v4 axis = lt_vld(n + LT_AXIS);
   lt_v4 ax, ay, az;
   lt_oct_decode_v(lt_vlo16(axis), lt_vhi16(axis), &ax, &ay, &az);
+  lt_v4 r = lt_vld(n + LT_R);
   lt_v4 cos_o = lt_vld(n + LT_COS_O);
-  lt_v4 cos_e = lt_vmul(lt_vlo16(lt_vld(n + LT_CE_CV2)), lt_vs(LT_U16_SCALE));
-  lt_without_orientation(t, &cos_o, &cos_e, &N);
-  return lt_fv(lt_importance_v(lt_vld(n + LT_CX), lt_vld(n + LT_CY), lt_vld(n + LT_CZ),
-                               lt_vld(n + LT_R), ax, ay, az, cos_o, cos_e, lt_vld(n + LT_ENERGY), P,
-                               N));
+  lt_v4 k16 = lt_vlo16(lt_vld(n + LT_CE_CV2));
+  lt_vm4 plane = lt_vgt(cos_o, lt_vs(1.5f)); // LT_PLANE_FLAG: k16 is the plane offset
+  lt_v4 cos_e = lt_vsel(lt_vmul(k16, lt_vs(LT_U16_SCALE)), lt_vs(0.0f), plane);
+  lt_v4 plane_h =
+      lt_vsel(lt_vs(LT_PLANE_NONE),
+              lt_vmul(lt_vsub(k16, lt_vs(32768.0f)), lt_vmul(r, lt_vs(LT_PLANE_H_UNIT))), plane);
+  cos_o = lt_vsel(cos_o, lt_vs(LT_PLANE_COS_O), plane);
+  lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
+  return lt_fv(lt_importance_v(lt_vld(n + LT_CX), lt_vld(n + LT_CY), lt_vld(n + LT_CZ), r, ax, ay,
+                               az, cos_o, cos_e, lt_vld(n + LT_ENERGY), plane_h, P, N, fallback));
+}
+LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) {
+  return lt_node_importance_f(t, node, P, N, 1);
 }
 
-// Importances of the four lanes below `code` (a node or a leaf).
+// Importances of the four lanes below `code` (a node or a leaf) for the split decisions: without
+// the fallback, so a cluster splits into exactly the lanes that can contribute (none where P sees
+// no emitter of the cluster: a point behind a ceiling of one-sided lights gets an empty cut).
 INLINE float4 lt_code_importance(const LtTree* t, int code, float3 P, float3 N) {
-  return code >= 0 ? lt_node_importance(t, code, P, N) : lt_leaf_importance(t, code, P, N);
+  return code >= 0 ? lt_node_importance_f(t, code, P, N, 0)
+                   : lt_leaf_importance_f(t, code, P, N, 0);
 }
 
 // Probability of lane k: I_k / (sum of the four). 0 if nothing contributes.

@@ -14,10 +14,10 @@ using namespace canopy::test;
 namespace {
 
 // Two slopes of a roof (ridge along y at x = 0): normals tilted to -x on the left, +x on the right,
-// or all +z when `flat_normals` (same geometry, no orientation difference).
-std::vector<Light> roof(bool flat_normals, float length) {
+// or all +z when `flat_normals` (same geometry, no orientation difference). Each slope is nx x ny
+// cells of two triangles: 4 nx ny triangles in all.
+std::vector<Light> roof(bool flat_normals, float length, int nx = 8, int ny = 16) {
   std::vector<Light> lights;
-  const int nx = 8, ny = 16;
   for (int side = 0; side < 2; ++side) {
     float sx = side == 0 ? -1.0f : 1.0f;
     for (int i = 0; i < nx; ++i) {
@@ -124,7 +124,10 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
             << "light " << l;
       }
       // cone covers the light's cone (axis decoded as the traversal decodes it)
-      double co = lane(code, LT_COS_O, k);
+      // a lane with a half-space bound (LT_PLANE_FLAG) has theta_o = LT_PLANE_SLOPE,
+      // theta_e = pi/2 (its 16 bits hold the plane offset)
+      const bool plane = lane(code, LT_COS_O, k) > 1.5f;
+      double co = plane ? double(LT_PLANE_COS_O) : double(lane(code, LT_COS_O, k));
       if (co > -1.0) {
         float4 ax, ay, az;
         float4 bits = t.nodes[size_t(code) * LT_NODE_F4 + LT_AXIS];
@@ -133,8 +136,9 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
         double need = angle_d(axis, b.cone.axis) + b.cone.theta_o;
         ASSERT_LE(need, std::acos(std::clamp(co, -1.0, 1.0)) + 1e-5) << "light " << l;
       }
-      double ce = f4_get(lt_lo16_4(t.nodes[size_t(code) * LT_NODE_F4 + LT_CE_CV2]), k) *
-                  double(LT_U16_SCALE);
+      double ce = plane ? 0.0
+                        : f4_get(lt_lo16_4(t.nodes[size_t(code) * LT_NODE_F4 + LT_CE_CV2]), k) *
+                              double(LT_U16_SCALE);
       ASSERT_LE(ce, std::cos(double(b.cone.theta_e)) + 1e-6);
       ASSERT_GE(lane(code, LT_ENERGY, k), b.energy * (1 - 1e-6));
       code = c;
@@ -151,7 +155,11 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
     ASSERT_EQ(rec[0].w, sp.w);
     ASSERT_EQ(rec[1].z, float(b.energy));
     float q = rec[1].y;
-    double rco = q > 1.5f ? 1.0 : double(q), rce = q > 1.5f ? double(q) - 2.0 : 0.0;
+    double rco = q > 1.5f ? 1.0 : (q < -1.5f ? double(LT_PLANE_COS_O) : double(q));
+    double rce = q > 1.5f ? double(q) - 2.0 : 0.0;
+    if (q < -1.5f) {
+      ASSERT_FALSE(std::isnan(b.plane_h)) << "light " << l; // one-sided planar only
+    }
     ASSERT_LE(rce, std::cos(double(b.cone.theta_e)) + 1e-7) << "light " << l;
     if (rco > -1.0) {
       float4 ax, ay, az;
@@ -171,11 +179,16 @@ void check_tree(const std::vector<Light>& lights, const LightTree& t) {
 
 } // namespace
 
-TEST(LightTreeBuild, SaohPrefersOrientationSplittingPartition) {
+class LightTreeBuildRoof : public ::testing::TestWithParam<std::tuple<int, int>> {};
+
+TEST_P(LightTreeBuildRoof, SaohPrefersOrientationSplittingPartition) {
   // The roof is longer along y (2.2) than across (2): by area alone (and K_r) the best cut is
   // across y, mixing both slopes; the orientation measure makes SAOH cut along the ridge instead
-  // (Fig. 5).
-  std::vector<Light> lights = roof(false, 2.2f);
+  // (Fig. 5). 512 triangles go through the binned SAOH; 32 and 64 are small enough to be packed
+  // into full leaves, which must still split by orientation.
+  const auto [nx, ny] = GetParam();
+  std::vector<Light> lights = roof(false, 2.2f, nx, ny);
+  ASSERT_EQ(int(lights.size()), 4 * nx * ny);
   BinaryLightTree bt = build_binary_light_tree(emitter_bounds(lights));
   const BinaryLightNode& root = bt.nodes[0];
   ASSERT_FALSE(root.is_leaf());
@@ -184,9 +197,14 @@ TEST(LightTreeBuild, SaohPrefersOrientationSplittingPartition) {
   EXPECT_NE(sides(bt, lights, root.right), 3) << "right child mixes both slopes";
   EXPECT_NEAR(bt.nodes[root.left].cone.theta_o, 0.0, 1e-4);
   EXPECT_NEAR(bt.nodes[root.right].cone.theta_o, 0.0, 1e-4);
+  // every leaf but one is full (the packing keeps 4 emitters per leaf)
+  int partial = 0;
+  for (const BinaryLightNode& x : bt.nodes)
+    if (x.is_leaf() && x.count < LT_MAX_LEAF) ++partial;
+  EXPECT_LE(partial, 1);
 
   // Control: identical geometry with identical normals: now the area term decides and cuts y.
-  std::vector<Light> flat = roof(true, 2.2f);
+  std::vector<Light> flat = roof(true, 2.2f, nx, ny);
   BinaryLightTree bf = build_binary_light_tree(emitter_bounds(flat));
   EXPECT_EQ(sides(bf, flat, bf.nodes[0].left), 3);
   EXPECT_EQ(sides(bf, flat, bf.nodes[0].right), 3);
@@ -194,6 +212,14 @@ TEST(LightTreeBuild, SaohPrefersOrientationSplittingPartition) {
   EXPECT_LT(saoh_cost(root, bt.nodes[root.left], bt.nodes[root.right]),
             saoh_cost(bf.nodes[0], bf.nodes[bf.nodes[0].left], bf.nodes[bf.nodes[0].right]) * 4.0);
 }
+
+INSTANTIATE_TEST_SUITE_P(Triangles, LightTreeBuildRoof,
+                         ::testing::Values(std::make_tuple(8, 16), // 512
+                                           std::make_tuple(2, 8),  // 64
+                                           std::make_tuple(2, 4)), // 32
+                         [](const ::testing::TestParamInfo<std::tuple<int, int>>& p) {
+                           return std::to_string(4 * std::get<0>(p.param) * std::get<1>(p.param));
+                         });
 
 TEST(LightTreeBuild, InvariantsMixedLights) {
   std::vector<Light> lights = mixed_lights(20000, 3, 10.0f);

@@ -6,6 +6,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cfloat>
 #include <cmath>
@@ -273,21 +274,15 @@ public:
       return;
     }
     // Small clusters (at most kPackLeaves leaves' worth, 64 emitters) are packed into as few full
-    // leaves as possible: median splits along the widest centroid axis into multiples of
-    // leaf_size (halving the number of leaves). Fuller leaves and fuller 4-wide nodes keep the
-    // tree with its emitter records under 64 bytes/emitter, and skip the SAOH binning where it
-    // matters least (the emitters of a leaf are ranked individually by their records anyway).
+    // leaves as possible: every split puts a multiple of leaf_size emitters on the left, so all
+    // leaves but one are full. Fuller leaves and fuller 4-wide nodes keep the tree with its
+    // emitter records under 64 bytes/emitter. Among those splits, the SAOH cost (Eq. 2, exact
+    // sweeps over the emitters sorted along each axis) chooses, so small clusters are split by
+    // orientation too (the paper's Fig. 5 roof of 32 triangles: one slope per child).
     if (n <= kPackLeaves * opt_.leaf_size && similar_energies(begin, end)) {
-      int leaves = (n + opt_.leaf_size - 1) / opt_.leaf_size;
-      int m = begin + opt_.leaf_size * ((leaves + 1) / 2);
-      float3 ce = acc.cmax - acc.cmin;
-      if (ce.x > 0 || ce.y > 0 || ce.z > 0) {
-        int a = ce.x >= ce.y && ce.x >= ce.z ? 0 : (ce.y >= ce.z ? 1 : 2);
-        std::nth_element(prims_.data() + begin, prims_.data() + m, prims_.data() + end,
-                         [a](const Prim& p, const Prim& q) { return comp(p.c, a) < comp(q.c, a); });
-      }
-      recurse(ni, begin, m, end, depth, reduce_range(prims_.data(), begin, m),
-              reduce_range(prims_.data(), m, end));
+      Acc l, r;
+      int m = pack_split(begin, end, depth, acc, &l, &r);
+      recurse(ni, begin, m, end, depth, l, r);
       return;
     }
     // Child capacity at depth + 1 so every leaf ends at binary depth <= kMaxBinaryDepth.
@@ -378,6 +373,98 @@ public:
   }
 
 private:
+  // The packing split of a cluster of at most kPackLeaves * leaf_size emitters (see build): the
+  // left child gets leaf_size * j emitters. Where the emitters' cones differ, j and the axis are
+  // chosen by the least SAOH cost among the j whose children still fit the bit-trail depth
+  // (ceil(log2(leaves)) more levels each); the sweeps accumulate whole leaves' worth of emitters
+  // (chunks), then merge chunks. Where every cone is the same (or every one is the full sphere,
+  // e.g. point lights), M_Omega is the same for every child and the split is the balanced median
+  // along the widest centroid axis, as fast as before. Reorders prims_[begin, end), returns the
+  // split index and the children's accumulators.
+  int pack_split(int begin, int end, int depth, const Acc& acc, Acc* lo, Acc* hi) {
+    const int n = end - begin, ls = opt_.leaf_size;
+    const int leaves = (n + ls - 1) / ls;
+    int m = begin + ls * ((leaves + 1) / 2);
+    const float3 cext = acc.cmax - acc.cmin;
+    Prim* p = prims_.data() + begin;
+    auto sort_axis = [&](int a) {
+      std::sort(p, p + n, [a](const Prim& x, const Prim& y) {
+        float cx = comp(x.c, a), cy = comp(y.c, a);
+        return cx < cy || (cx == cy && x.id < y.id);
+      });
+    };
+    auto median = [&] {
+      if (cext.x > 0 || cext.y > 0 || cext.z > 0) {
+        int a = cext.x >= cext.y && cext.x >= cext.z ? 0 : (cext.y >= cext.z ? 1 : 2);
+        std::nth_element(p, prims_.data() + m, p + n,
+                         [a](const Prim& x, const Prim& y) { return comp(x.c, a) < comp(y.c, a); });
+      }
+      *lo = reduce_range(prims_.data(), begin, m);
+      *hi = reduce_range(prims_.data(), m, end);
+      return m;
+    };
+    bool all_full = true, all_same = true;
+    const HCone& c0 = p[0].cone;
+    for (int i = 0; i < n; ++i) {
+      const HCone& c = p[i].cone;
+      all_full = all_full && c.to >= kPi;
+      all_same = all_same && c.to == c0.to && c.te == c0.te && c.axis.x == c0.axis.x &&
+                 c.axis.y == c0.axis.y && c.axis.z == c0.axis.z;
+    }
+    if (all_full || all_same || !(cext.x > 0 || cext.y > 0 || cext.z > 0)) return median();
+
+    const int room = kMaxBinaryDepth - depth - 1; // levels below each child
+    auto fits = [&](int count) {
+      int lv = (count + ls - 1) / ls, need = 0;
+      while ((1 << need) < lv)
+        ++need;
+      return need <= room;
+    };
+    const float3 ext = acc.bmax - acc.bmin;
+    const float lmax = std::max({ext.x, ext.y, ext.z});
+    const float delta = 1e-3f * lmax;
+    std::array<Acc, kPackLeaves + 1> left, right; // the first / last chunks up to chunk j
+    double best = INFINITY;
+    int best_axis = -1, best_j = 0, sorted = -1;
+    for (int a = 0; a < 3; ++a) {
+      const float len = comp(ext, a);
+      if (!(comp(cext, a) > 0) || !(len > 0)) continue;
+      sort_axis(a);
+      sorted = a;
+      for (int j = 0; j < leaves; ++j) { // right[j]: chunk j alone for now
+        right[j] = Acc();
+        for (int i = ls * j; i < std::min(n, ls * (j + 1)); ++i)
+          right[j].add(p[i]);
+      }
+      left[0] = Acc();
+      for (int j = 1; j < leaves; ++j) {
+        left[j] = left[j - 1];
+        left[j].merge(right[j - 1]);
+      }
+      for (int j = leaves - 2; j >= 1; --j)
+        right[j].merge(right[j + 1]); // right[j]: chunks j .. leaves - 1
+      const double kr = double(lmax) / double(len);
+      for (int j = 1; j < leaves; ++j) {
+        const Acc &l = left[j], &r = right[j];
+        if (!fits(l.count) || !fits(r.count)) continue;
+        const double wl = acc.e > 0 ? l.e : double(l.count);
+        const double wr = acc.e > 0 ? r.e : double(r.count);
+        const double cost = kr * (wl * area_measure(l.bmin, l.bmax, delta) * m_omega(l.cone) +
+                                  wr * area_measure(r.bmin, r.bmax, delta) * m_omega(r.cone));
+        if (cost < best) {
+          best = cost;
+          best_axis = a;
+          best_j = j;
+          *lo = l;
+          *hi = r;
+        }
+      }
+    }
+    if (best_axis < 0) return median(); // no split fits the depth: the balanced median
+    if (sorted != best_axis) sort_axis(best_axis);
+    return begin + ls * best_j;
+  }
+
   void recurse(int ni, int begin, int mid, int end, int depth, const Acc& l, const Acc& r) {
     int li = next.fetch_add(2);
     nodes_[ni].left = li;
@@ -449,6 +536,41 @@ float BinaryLightNode::cv2() const {
   return v > 0 ? static_cast<float>(v) : 0.0f;
 }
 
+namespace {
+// EmitterBounds::plane_h. The renderer's emission test is dot(L.n, P - x) > 0 for the sampled or
+// hit point x (cl/light_sample.h), so the emitter sends nothing to P if dot(n, P) <= min over its
+// vertices of dot(n, x) (a linear function is smallest at a vertex of the polygon). The margin,
+// 2^-20 (|p| + |e1| + |e2|) in the 1-norm, covers the rounding of the sample points (gamma(6) of
+// the same sum, cl/light_sample.h), of the geometry triangles' vertices, of n's normalisation
+// (L.n's direction to ~1e-7 times the emitter's radius) and of this double evaluation.
+double plane_offset(const Light& l, const EmitterBounds& b) {
+  if ((l.type != LIGHT_QUAD && l.type != LIGHT_TRIANGLE) || (l.flags & LIGHT_FLAG_TWO_SIDED) ||
+      b.cos_o < 1.0f)
+    return NAN;
+  const double nl =
+      std::sqrt(double(l.n.x) * l.n.x + double(l.n.y) * l.n.y + double(l.n.z) * l.n.z);
+  if (!(nl > 0) || !std::isfinite(nl)) return NAN; // no emitting side
+  const float3 n = b.cone.axis;
+  const float4 c = lt_sphere_of_box(b.bmin, b.bmax);
+  const double p[3] = {l.p.x, l.p.y, l.p.z}, e1[3] = {l.e1.x, l.e1.y, l.e1.z},
+               e2[3] = {l.e2.x, l.e2.y, l.e2.z}, cc[3] = {c.x, c.y, c.z}, nn[3] = {n.x, n.y, n.z};
+  double h = -INFINITY, norm1 = 0;
+  const int corners = l.type == LIGHT_QUAD ? 4 : 3;
+  for (int v = 0; v < corners; ++v) {
+    double s = 0;
+    for (int k = 0; k < 3; ++k) {
+      double x = p[k] + ((v & 1) ? e1[k] : 0.0) + ((v & 2) ? e2[k] : 0.0);
+      s += nn[k] * (cc[k] - x);
+    }
+    h = std::max(h, s);
+  }
+  for (int k = 0; k < 3; ++k)
+    norm1 += std::fabs(p[k]) + std::fabs(e1[k]) + std::fabs(e2[k]);
+  h += std::ldexp(norm1, -20);
+  return std::isfinite(h) ? h : NAN;
+}
+} // namespace
+
 EmitterBounds emitter_bounds(const Light& light) {
   EmitterBounds b;
   float3 axis;
@@ -474,6 +596,7 @@ EmitterBounds emitter_bounds(const Light& light) {
     energy = lum * (light.type == LIGHT_QUAD ? area : 0.5 * area);
   }
   b.energy = (energy > 0 && std::isfinite(energy)) ? energy : 0.0;
+  b.plane_h = plane_offset(light, b);
   return b;
 }
 
@@ -602,11 +725,31 @@ inline float float_down(double x) {
   return double(f) > x ? std::nextafter(f, -FLT_INF) : f;
 }
 
+// The unit vector that octahedral bits decode to on the device (lt_oct_decode_v).
+float3 oct_decode(uint32_t bits) {
+  float4 ax, ay, az;
+  lt_oct_decode4(lt_splat4(float(bits & 0xffffu)), lt_splat4(float(bits >> 16)), &ax, &ay, &az);
+  return make_float3(ax.x, ay.x, az.x);
+}
+double chord(float3 a, float3 b) {
+  double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+// The angle a chord subtends (>= the chord), slightly rounded up.
+double chord_angle(double c) {
+  return 2.0 * std::asin(std::min(1.0, 0.5 * c)) * (1.0 + 1e-12) + 1e-15;
+}
+// Largest angle between a lane's decoded axis and an emitter normal for which the lane may keep a
+// half-space bound (LT_PLANE_SLOPE covers it plus the test's rounding, LT_PLANE_ROUND).
+constexpr double kPlaneAngle = double(LT_PLANE_SLOPE) - double(LT_PLANE_ROUND);
+
 // The emitter record of one emitter (LT_EMITTER_F4 float4, see cl/light_tree_math.h): sphere;
 // (octahedral axis bits, q, energy, light index). q packs the cone: q <= 1: cos(theta_o) with
-// theta_e = pi/2; q > 1.5: theta_o = 0 and cos(theta_e) = q - 2 (exact). The cone is widened by
-// the axis quantisation error (theta_o when theta_e = pi/2, else theta_e), so the record's
-// importance is 0 only where the exact emitter's is.
+// theta_e = pi/2; q > 1.5: theta_o = 0 and cos(theta_e) = q - 2 (exact); q < -1.5: a one-sided
+// planar emitter, theta_o = LT_PLANE_SLOPE, theta_e = pi/2 and the half-space bound h = (-2 - q) r
+// (as the device computes it, >= plane_h; see LT_PLANE_SLOPE).
+// The cone is widened by the axis quantisation error (theta_o when theta_e = pi/2, else theta_e),
+// so the record's importance is 0 only where the exact emitter's is.
 void emitter_record(const EmitterBounds& b, int light, float4* rec) {
   rec[0] = lt_sphere_of_box(b.bmin, b.bmax);
   double err = 0;
@@ -614,8 +757,18 @@ void emitter_record(const EmitterBounds& b, int light, float4* rec) {
   double pad = err * 1.001 + 1e-7;
   double to = b.cos_o >= 1.0f ? 0.0 : (b.cos_o <= -1.0f ? M_PI : std::acos(double(b.cos_o)));
   double te = b.cos_e <= 0.0f ? M_PI / 2 : std::acos(double(b.cos_e));
+  const float r = rec[0].w;
   float q;
-  if (b.cos_o <= -1.0f) {
+  if (!std::isnan(b.plane_h) && r > 0.0f && pad <= kPlaneAngle) {
+    // dot(n, P - x) = dot(n, P - c) + dot(n, c - x) <= dot(a, P - c) + |n - a| |P - c| + plane_h,
+    // and |n - a| <= pad <= kPlaneAngle: the middle term is within LT_PLANE_SLOPE |P - c|.
+    // q < -1.5 flags the bound: h > -r / 2 (h >= -r always; a larger h only culls less)
+    const double h = std::max(b.plane_h, -0.49 * double(r));
+    q = float_down(-2.0 - h / double(r));
+    while (std::isfinite(q) && double((-2.0f - q) * r) < h)
+      q = std::nextafter(q, -FLT_INF);
+    if (!std::isfinite(q)) q = std::max(float_down(std::cos(to + pad)), -1.0f); // no bound
+  } else if (b.cos_o <= -1.0f) {
     q = -1.0f; // omnidirectional: the axis does not matter
   } else if (b.cos_e <= 0.0f || to > 0.0) {
     // theta_e = pi/2 (or a general cone, widened to theta_o + theta_e, theta_e = pi/2)
@@ -637,8 +790,43 @@ void emitter_record(const EmitterBounds& b, int light, float4* rec) {
 struct TooDeep {};
 struct Collapser {
   const BinaryLightTree& bt;
+  const std::vector<EmitterBounds>& eb;
   LightTree& t;
   bool greedy;
+
+  // Half-space bound of a lane (see LT_PLANE_SLOPE) whose emitters are all one-sided planar with
+  // normals n_i within kPlaneAngle of the decoded axis a: for x on emitter i (sphere c_i, r_i),
+  //   dot(n_i, P - x) <= dot(a, P - x) + |n_i - a| |P - x|, |P - x| <= |P - c| + r,
+  //   dot(a, P - x) = dot(a, P - c) + dot(a, c - c_i) + dot(a, c_i - x),
+  //   dot(a, c_i - x) <= dot(n_i, c_i - x) + |a - n_i| r_i <= plane_h_i + |a - n_i| r_i,
+  // so h = max_i [dot(a, c - c_i) + plane_h_i + |n_i - a| (r_i + r)] and |n_i - a| |P - c| is
+  // within LT_PLANE_SLOPE |P - c|. Returns the 16-bit k with (k - 32768) * (r * LT_PLANE_H_UNIT)
+  // >= h (as the device computes it), or -1 if the lane gets no bound.
+  int plane_code(const BinaryLightNode& s, float4 sp, uint32_t oct) const {
+    if (!(sp.w > 0.0f) || !(s.cone.theta_o <= 2.0 * kPlaneAngle)) return -1;
+    const float3 a = oct_decode(oct);
+    const double ax = a.x, ay = a.y, az = a.z;
+    double h = -INFINITY, scale = std::fabs(sp.x) + std::fabs(sp.y) + std::fabs(sp.z);
+    for (int i = s.first; i < s.first + s.count; ++i) {
+      const EmitterBounds& e = eb[size_t(bt.order[size_t(i)])];
+      if (std::isnan(e.plane_h)) return -1;
+      const double ch = chord(a, e.cone.axis);
+      if (chord_angle(ch) > kPlaneAngle) return -1;
+      const float4 ci = lt_sphere_of_box(e.bmin, e.bmax);
+      const double v = ax * (double(sp.x) - ci.x) + ay * (double(sp.y) - ci.y) +
+                       az * (double(sp.z) - ci.z) + e.plane_h + ch * (double(ci.w) + sp.w);
+      h = std::max(h, v);
+      scale = std::max(scale, double(std::fabs(ci.x) + std::fabs(ci.y) + std::fabs(ci.z)));
+    }
+    h += std::ldexp(scale, -40); // the double rounding of the dot products
+    // signed: h = (k - 32768) * (r * 2^-14), in [-2r, 2r) (|h| <= r up to the margins)
+    const float unit = sp.w * LT_PLANE_H_UNIT;
+    double k = std::ceil(std::max(h / double(unit), -32768.0)) + 32768.0;
+    if (!(k <= 65535.0)) return -1;
+    while (k <= 65535.0 && double((float(k) - 32768.0f) * unit) < h)
+      k += 1.0;
+    return k <= 65535.0 ? int(k) : -1;
+  }
 
   bool leafish(int bi) const {
     const BinaryLightNode& n = bt.nodes[bi];
@@ -666,6 +854,11 @@ struct Collapser {
     while (k > 0 && double(float(k) * LT_U16_SCALE) > ce)
       --k;
     uint32_t cv2_bits = float_as_uint_(s.cv2()) & 0xffff0000u;
+    int plane = plane_code(s, sp, float_as_uint_(v[LT_AXIS]));
+    if (plane >= 0) { // theta_e = pi/2: the 16 bits hold the plane offset
+      v[LT_COS_O] = LT_PLANE_FLAG;
+      k = uint32_t(plane);
+    }
     v[LT_CE_CV2] = uint_as_float_(cv2_bits | k);
     for (int kk = 0; kk < LT_NODE_F4; ++kk)
       set_lane_value(f[kk], lane, v[kk]);
@@ -756,7 +949,7 @@ LightTree collapse_light_tree(const BinaryLightTree& bt, const std::vector<Emitt
     t.nodes.reserve(bt.nodes.size() / 6 * LT_NODE_F4 + LT_NODE_F4 +
                     size_t(num_lights) * LT_EMITTER_F4);
     t.children.reserve(bt.nodes.size() / 6 + 1);
-    Collapser c{bt, t, greedy};
+    Collapser c{bt, eb, t, greedy};
     try {
       c.fill(c.alloc_node(), 0, 0, 0u);
       break;

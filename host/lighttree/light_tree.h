@@ -5,8 +5,10 @@
 // Device layout (upload each vector as one buffer, as is; see the top of cl/light_tree_math.h):
 //   nodes        float4 x LT_NODE_F4 (8) per 4-wide node: per-lane sphere centre x/y/z, radius,
 //                octahedral cone axis, cos(theta_o), energy, cos(theta_e) | energy CV^2 (16 bits
-//                each); then LT_EMITTER_F4 (2) float4 per emitter in leaf order (emitter records:
-//                sphere; axis, cone, energy, light index)
+//                each; lanes of one-sided planar emitters flag a half-space bound in cos(theta_o)
+//                and keep its offset in the cos(theta_e) bits); then LT_EMITTER_F4 (2) float4 per
+//                emitter in leaf order (emitter records: sphere; axis, cone or plane offset,
+//                energy, light index)
 //   children     int4 per node: child node index, LT_EMPTY, or a leaf code (lt_leaf_code)
 //   leaf_lights  int per emitter, light indices in leaf order (leaves are contiguous ranges)
 //   trails       uint per light index: bit-trail, 2 bits per level from the root, then 2 bits for
@@ -18,6 +20,7 @@
 
 #include "light_tree_math.h" // cl/: LtCone, LtTree, layout constants
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -33,6 +36,13 @@ struct EmitterBounds {
   LtCone cone; // axis, theta_o, theta_e
   double energy;
   float cos_o, cos_e; // the cone as lt_light_bounds gives it (cosines, exact)
+  // One-sided planar emitters (quad, triangle; not two-sided, with a normal): the largest
+  // dot(n, c - x) over its vertices x (n = cone.axis, c = the centre of lt_sphere_of_box(bmin,
+  // bmax)) plus a margin for the float rounding of its sample and hit points, so every point
+  // the renderer can sample on it lies on the front side of the plane through c - plane_h n
+  // (negative when c is behind that plane, e.g. the box centre of a tilted triangle). NaN for
+  // every other emitter (no half-space bound).
+  double plane_h = NAN;
 };
 EmitterBounds emitter_bounds(const Light& light);
 std::vector<EmitterBounds> emitter_bounds(const std::vector<Light>& lights); // parallel

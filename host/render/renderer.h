@@ -36,7 +36,7 @@ struct RenderStats {
   uint64_t samples = 0;
   uint64_t shading_points = 0; // surface hits shaded
   uint64_t shadow_rays = 0;
-  std::vector<uint64_t> cut_size_histogram; // shading points by number of shadow items pushed
+  std::vector<uint64_t> cut_size_histogram; // shading points by number of cut members
   std::string kernel_options;               // the -D options the kernels were compiled with
   uint64_t nonfinite_samples = 0; // samples that were not finite and were recorded as zero
   // Pixels whose resolved value (film mean) lies beyond the float32 range of the output image:

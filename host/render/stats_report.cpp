@@ -4,6 +4,23 @@
 
 namespace canopy {
 
+namespace {
+// Cut members over all shading points: sum of k * histogram[k] (the last bin counts k or more, so
+// the sum is exact only while it is empty).
+struct CutTotals {
+  uint64_t members = 0;
+  bool exact = true;
+};
+CutTotals cut_totals(const RenderStats& s) {
+  CutTotals t;
+  const size_t bins = s.cut_size_histogram.size();
+  for (size_t k = 0; k < bins; ++k)
+    t.members += uint64_t(k) * s.cut_size_histogram[k];
+  t.exact = bins == 0 || s.cut_size_histogram[bins - 1] == 0;
+  return t;
+}
+} // namespace
+
 nlohmann::json stats_to_json(const RenderStats& s, const RunTimings& run) {
   nlohmann::json j;
   j["wall_seconds"] = {{"total", run.total_seconds}, {"load", run.load_seconds},
@@ -29,8 +46,13 @@ nlohmann::json stats_to_json(const RenderStats& s, const RunTimings& run) {
   nlohmann::json hist = nlohmann::json::array();
   for (uint64_t c : s.cut_size_histogram)
     hist.push_back(c);
-  j["cut_size_histogram"] = hist; // index k: shading points whose light cut had k shadow items
-                                  // (last bin: that many or more)
+  // index k: shading points whose light cut had k members (clusters picked from or lights taken,
+  // each a light_pick work item; a member yields at most one shadow ray). Last bin: k or more.
+  j["cut_size_histogram"] = hist;
+  const CutTotals ct = cut_totals(s);
+  j["cut_members"] = ct.members; // a lower bound if cut_members_exact is false
+  j["cut_members_exact"] = ct.exact;
+  j["shadow_rays_per_cut_member"] = ct.members ? double(s.shadow_rays) / double(ct.members) : 0.0;
   return j;
 }
 
@@ -52,7 +74,11 @@ std::string stats_to_table(const RenderStats& s, const RunTimings& run) {
                      s.samples, s.shading_points, s.shadow_rays,
                      s.shading_points ? double(s.shadow_rays) / double(s.shading_points) : 0.0,
                      s.nonfinite_samples, s.overflowed_pixels, -s.emission_exponent);
-  out += "cut sizes:";
+  const CutTotals ct = cut_totals(s);
+  out += fmt::format("cut members {}{} ({:.1f}% yield a shadow ray)\n",
+                     ct.exact ? "" : ">= ", ct.members,
+                     ct.members ? 100.0 * double(s.shadow_rays) / double(ct.members) : 0.0);
+  out += "cut sizes (shading points by cut members):";
   for (size_t k = 0; k < s.cut_size_histogram.size(); ++k)
     if (s.cut_size_histogram[k])
       out += fmt::format(" {}{}:{}", k, k + 1 == s.cut_size_histogram.size() ? "+" : "",
