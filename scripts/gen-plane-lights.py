@@ -22,7 +22,7 @@ import random
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # Total radiant intensity of all lights, W/sr per channel. With this value the plane's centre has
-# a radiance of roughly 0.6 (albedo 0.5, irradiance ~ pi/2 * TOTAL_INTENSITY * 0.75 there).
+# a radiance of about 0.77 (irradiance 4.8 W/m^2 there for N -> infinity, albedo 0.5 / pi).
 TOTAL_INTENSITY = 4.0
 SEED = 20181
 

@@ -22,12 +22,13 @@ namespace {
 // Keys are echoed in JSON paths; a longer key is cut with an ellipsis.
 constexpr size_t kMaxKeyChars = 64;
 
-// Builds the DOM from nlohmann's SAX events (what json::parse does) and rejects a duplicate key,
+// nlohmann-json's parser, run only on text the fast parser (below) rejects, for its messages:
+// builds nlohmann's DOM from its SAX events (what json::parse does) and rejects a duplicate key,
 // which nlohmann would silently resolve to the last value, as "<file>: <path>.<key>: duplicate
 // key". The check is the insertion into the object's own map, O(log keys); the path is built only
-// for the message. (A parse callback did the same check before, but nlohmann's callback parser
-// scans the parent container at every object end: quadratic in the length of an array of objects,
-// 10 minutes for 10^6 lights.)
+// for the message. (A parse callback did this check before, but nlohmann's callback parser scans
+// the parent container at every object end: quadratic in the length of an array of objects, 10
+// minutes for 10^6 lights.)
 class DomBuilder {
 public:
   DomBuilder(json& root, const std::string& file) : root_(root), file_(file) {}
