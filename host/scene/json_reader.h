@@ -1,11 +1,9 @@
-// A small path-tracking reader over nlohmann::json: every accessor knows where in the document it
-// is, so every validation error names the file and the JSON path, e.g.
-// "scene.json: lights[3].radius: must be > 0".
+// A small path-tracking reader over a parsed JSON document: every accessor knows where in the
+// document it is, so every validation error names the file and the JSON path, e.g. "scene.json:
+// lights[3].radius: must be > 0".
 #pragma once
 
 #include "scene/scene.h"
-
-#include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <initializer_list>
@@ -16,31 +14,89 @@
 
 namespace canopy::detail {
 
-using json = nlohmann::json;
-
 // "<file>: <path>: <problem>" (path "(root)" for the document itself).
 [[noreturn]] void throw_error(const std::string& file, const std::string& path,
                               std::string_view problem);
 
-// Parses JSON text; a syntax error becomes "<file>: line L, column C: <problem>".
-json parse_json(const std::string& text, const std::string& file);
+// The parsed JSON document: a flat array of 16-byte nodes, each container's children contiguous.
+// A value's JSON path is built only when a message needs it (path(): a search for the parents,
+// linear in the document, once per error). Strings without escapes point into the source text,
+// which must outlive the document.
+class Document {
+public:
+  enum class Type : uint8_t {
+    null,
+    boolean,
+    integer,
+    unsigned_integer,
+    floating,
+    string,
+    array,
+    object
+  };
+  static constexpr uint32_t kNone = 0xffffffffu;
+  struct Node {
+    Type type = Type::null;
+    bool in_text = false; // string: bytes are in the source text (else in the arena)
+    uint32_t n = 0;       // string: bytes; array: elements; object: members
+    union {
+      bool b;
+      int64_t i;
+      uint64_t u;
+      double f;
+      uint64_t str;   // string: offset in the text or the arena
+      uint32_t first; // array: first element; object: first key (keys and values alternate)
+    };
+    Node() : u(0) {}
+    uint32_t span() const { return type == Type::object ? 2 * n : type == Type::array ? n : 0; }
+  };
+
+  const Node& node(uint32_t i) const { return nodes[i]; }
+  std::string_view str(const Node& n) const {
+    return n.in_text ? text.substr(n.str, n.n) : std::string_view(arena).substr(n.str, n.n);
+  }
+  // "lights[3].position" ("" for the root); keys shortened for messages.
+  std::string path(uint32_t i) const;
+  // The array or object holding node i (kNone for the root).
+  uint32_t parent(uint32_t i) const;
+
+  std::string_view text;
+  std::string arena; // decoded strings that had escapes
+  std::vector<Node> nodes;
+  uint32_t root = kNone;
+};
+
+// Parses JSON text (comments allowed) into `doc`, which refers to `text`. A syntax error becomes
+// "<file>: line L, column C: <problem>", a duplicate key "<file>: <path>: duplicate key".
+void parse_json(const std::string& text, const std::string& file, Document& doc);
+
+// The fast parser alone: true and a complete `doc` if `text` is valid JSON without duplicate
+// keys whose numbers it can convert exactly like nlohmann-json; false otherwise (parse_json then
+// takes nlohmann-json's parser for the message). Exposed for tests.
+bool fast_parse_json(std::string_view text, Document& doc);
 
 class JsonObject;
 
 class JsonValue {
 public:
-  JsonValue(const json& j, std::string path, const std::string& file)
-      : j_(&j), path_(std::move(path)), file_(&file) {}
+  JsonValue(const Document& doc, uint32_t index, const std::string& file)
+      : doc_(&doc), i_(index), file_(&file) {}
 
   [[noreturn]] void fail(std::string_view problem) const;
-  const std::string& path() const { return path_; }
+  std::string path() const { return doc_->path(i_); }
   const std::string& file() const { return *file_; }
-  const json& raw() const { return *j_; }
+  const Document& doc() const { return *doc_; }
+  uint32_t index() const { return i_; }
+  const Document::Node& node() const { return doc_->node(i_); }
 
-  bool is_object() const { return j_->is_object(); }
-  bool is_array() const { return j_->is_array(); }
-  bool is_string() const { return j_->is_string(); }
-  bool is_number() const { return j_->is_number(); }
+  bool is_object() const { return node().type == Document::Type::object; }
+  bool is_array() const { return node().type == Document::Type::array; }
+  bool is_string() const { return node().type == Document::Type::string; }
+  bool is_number() const {
+    auto t = node().type;
+    return t == Document::Type::integer || t == Document::Type::unsigned_integer ||
+           t == Document::Type::floating;
+  }
 
   // Scalars. Every number must be finite (also after conversion to float).
   double as_double() const;
@@ -70,8 +126,8 @@ public:
   JsonObject as_object() const;
 
 private:
-  const json* j_;
-  std::string path_;
+  const Document* doc_;
+  uint32_t i_;
   const std::string* file_;
 };
 
@@ -97,8 +153,15 @@ public:
   std::string child_path(std::string_view key) const;
 
 private:
+  // Index of the member named `key`, or npos.
+  size_t find(std::string_view key) const;
+  void mark_read(size_t member) const;
+  bool was_read(size_t member) const;
+
   JsonValue v_;
-  mutable std::vector<std::string> read_;
+  // Members read by get()/req(): a bit per member (the first 64 inline, no allocation per light).
+  mutable uint64_t read_mask_ = 0;
+  mutable std::vector<bool> read_more_;
 };
 
 } // namespace canopy::detail

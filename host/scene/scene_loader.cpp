@@ -242,7 +242,8 @@ namespace {
 Scene load_from_string(const std::string& json_text, const std::string& name,
                        const std::filesystem::path& base_dir) {
   using namespace detail;
-  json doc = parse_json(json_text, name);
+  Document doc;
+  parse_json(json_text, name, doc);
   Scene scene;
   scene.path = name;
   MaterialDesc def;
@@ -255,7 +256,7 @@ Scene load_from_string(const std::string& json_text, const std::string& name,
   Builder b{scene, name, base_dir, {}, {}, {}};
   b.material_by_name["default"] = 0;
 
-  JsonValue root(doc, "", name);
+  JsonValue root(doc, doc.root, name);
   auto o = root.as_object();
   o.allow({"camera", "film", "integrator", "materials", "shapes", "lights", "light_sets"});
   parse_camera(o.req("camera"), scene.camera);
