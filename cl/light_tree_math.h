@@ -697,7 +697,7 @@ LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt
   // Fast path: four full-sphere cones (theta_o = pi: points, spheres, two-sided emitters and
   // their clusters, every lane under LT_TERMS_DISTANCE) bound every direction, theta' = 0 and
   // cos(theta') = 1; for finite P the general code gives exactly the same (c1 = 1, s1 = 0, c2 = 1)
-  // at the cost of the axis (lt_lanes_full_sphere: not even decoded) and a third of this function.
+  // at the cost of the axis (lt_decode_axes: not even decoded) and a third of this function.
   lt_v4 orient;
   if (lt_vall(lt_vle(cos_o, lt_vs(-1.0f)))) {
     orient = lt_vsel(zero, one, lt_vgt(one, cos_e));
