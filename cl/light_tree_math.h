@@ -276,6 +276,7 @@ INLINE float lt_vhmax(float4 a) {
 INLINE float lt_vhmin(float4 a) {
   return fmin(fmin(a.x, a.y), fmin(a.z, a.w));
 }
+#define lt_vall(m) all(m)
 #elif defined(__SSE2__)
 typedef __m128 lt_v4;
 typedef __m128 lt_vm4;
@@ -313,6 +314,7 @@ INLINE lt_v4 lt_vhi16(lt_v4 a) {
   return _mm_cvtepi32_ps(_mm_srli_epi32(_mm_castps_si128(a), 16));
 }
 #define lt_vtranspose(a, b, c, d) _MM_TRANSPOSE4_PS(a, b, c, d)
+#define lt_vall(m) (_mm_movemask_ps(m) == 15) /* every lane of a comparison mask is set */
 INLINE float lt_vhmax(lt_v4 a) {
   __m128 m = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
   return _mm_cvtss_f32(_mm_max_ss(m, _mm_movehl_ps(m, m)));
@@ -353,6 +355,7 @@ INLINE float lt_vhmax(float4 a) {
 INLINE float lt_vhmin(float4 a) {
   return lt_minf(lt_minf(a.x, a.y), lt_minf(a.z, a.w));
 }
+#define lt_vall(m) ((m).x && (m).y && (m).z && (m).w)
 #endif
 #if defined(__OPENCL_C_VERSION__) || !defined(__SSE2__)
 // float4 lanes (OpenCL C, or C++ without SSE2): the same transpose and horizontal sum.
@@ -720,26 +723,39 @@ LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt
   lt_v4 cos_u = lt_vmin(lt_vmul(lt_vsqrt(lt_vmax(lt_vsub(d2, r2), zero)), inv_d), one);
   sin_u = lt_vsel(sin_u, zero, inside);
   cos_u = lt_vsel(cos_u, lt_vs(-1.0f), inside);
-  // theta: angle between the cone axis and the direction from the cluster towards P
-  lt_v4 cos_t = lt_vmul(
-      lt_vsub(zero, lt_vadd(lt_vadd(lt_vmul(ax, dx), lt_vmul(ay, dy)), lt_vmul(az, dz))), inv_d);
-  // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
-  lt_vm4 front =
-      lt_vgt(cos_t, lt_vsub(zero, lt_vadd(lt_vmul(plane_h, inv_d), lt_vs(LT_PLANE_SLOPE))));
-  lt_v4 kx = lt_vsub(lt_vmul(ay, dz), lt_vmul(az, dy));
-  lt_v4 ky = lt_vsub(lt_vmul(az, dx), lt_vmul(ax, dz));
-  lt_v4 kz = lt_vsub(lt_vmul(ax, dy), lt_vmul(ay, dx));
-  lt_v4 sin_t = lt_vmin(
-      lt_vmul(lt_vsqrt(lt_vadd(lt_vadd(lt_vmul(kx, kx), lt_vmul(ky, ky)), lt_vmul(kz, kz))), inv_d),
-      one);
-  lt_v4 sin_o = lt_vsqrt(lt_vmax(lt_vsub(one, lt_vmul(cos_o, cos_o)), zero));
-  // theta - theta_o, clamped at 0
-  lt_vm4 within_o = lt_vge(cos_t, cos_o);
-  lt_v4 c1 = lt_vsel(lt_vadd(lt_vmul(cos_t, cos_o), lt_vmul(sin_t, sin_o)), one, within_o);
-  lt_v4 s1 = lt_vsel(lt_vsub(lt_vmul(sin_t, cos_o), lt_vmul(cos_t, sin_o)), zero, within_o);
-  // minus theta_u, clamped at 0
-  lt_v4 c2 = lt_vsel(lt_vadd(lt_vmul(c1, cos_u), lt_vmul(s1, sin_u)), one, lt_vge(c1, cos_u));
-  lt_v4 orient = lt_vsel(zero, c2, lt_vgt(c2, cos_e));
+  // Fast path: four full-sphere cones (theta_o = pi: points, spheres, two-sided emitters and
+  // their clusters, every lane under LT_TERMS_DISTANCE) bound every direction, theta' = 0 and
+  // cos(theta') = 1; for finite P the general code gives exactly the same (c1 = 1, s1 = 0, c2 = 1)
+  // at the cost of the axis (lt_decode_axes: not even decoded) and a third of this function.
+  // Full-sphere lanes never carry a half-space bound, so `front` is all true there.
+  lt_v4 orient;
+  lt_vm4 full = lt_vle(cos_o, lt_vs(-1.0f));
+  lt_vm4 front = full;
+  if (lt_vall(full)) {
+    orient = lt_vsel(zero, one, lt_vgt(one, cos_e));
+  } else {
+    // theta: angle between the cone axis and the direction from the cluster towards P
+    lt_v4 cos_t = lt_vmul(
+        lt_vsub(zero, lt_vadd(lt_vadd(lt_vmul(ax, dx), lt_vmul(ay, dy)), lt_vmul(az, dz))), inv_d);
+    // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
+    front =
+        lt_vgt(cos_t, lt_vsub(zero, lt_vadd(lt_vmul(plane_h, inv_d), lt_vs(LT_PLANE_SLOPE))));
+    lt_v4 kx = lt_vsub(lt_vmul(ay, dz), lt_vmul(az, dy));
+    lt_v4 ky = lt_vsub(lt_vmul(az, dx), lt_vmul(ax, dz));
+    lt_v4 kz = lt_vsub(lt_vmul(ax, dy), lt_vmul(ay, dx));
+    lt_v4 sin_t = lt_vmin(
+        lt_vmul(lt_vsqrt(lt_vadd(lt_vadd(lt_vmul(kx, kx), lt_vmul(ky, ky)), lt_vmul(kz, kz))),
+                inv_d),
+        one);
+    lt_v4 sin_o = lt_vsqrt(lt_vmax(lt_vsub(one, lt_vmul(cos_o, cos_o)), zero));
+    // theta - theta_o, clamped at 0
+    lt_vm4 within_o = lt_vge(cos_t, cos_o);
+    lt_v4 c1 = lt_vsel(lt_vadd(lt_vmul(cos_t, cos_o), lt_vmul(sin_t, sin_o)), one, within_o);
+    lt_v4 s1 = lt_vsel(lt_vsub(lt_vmul(sin_t, cos_o), lt_vmul(cos_t, sin_o)), zero, within_o);
+    // minus theta_u, clamped at 0
+    lt_v4 c2 = lt_vsel(lt_vadd(lt_vmul(c1, cos_u), lt_vmul(s1, sin_u)), one, lt_vge(c1, cos_u));
+    orient = lt_vsel(zero, c2, lt_vgt(c2, cos_e));
+  }
   // incidence at P
   lt_v4 cos_i = one;
   if (N.x != 0.0f || N.y != 0.0f || N.z != 0.0f) {
@@ -853,6 +869,18 @@ INLINE void lt_without_orientation(const LtTree* t, lt_v4* cos_o, lt_v4* cos_e, 
   *N = make_float3(0.0f, 0.0f, 0.0f);
 }
 
+// The cone axes of four lanes from their octahedral bits, decoded only if some lane's cone is not
+// the full sphere (cos_o = -1): lt_importance_v ignores the axes of four full-sphere lanes.
+LT_HOT void lt_decode_axes(lt_v4 bits, lt_v4 cos_o, lt_v4* ax, lt_v4* ay, lt_v4* az) {
+  if (lt_vall(lt_vle(cos_o, lt_vs(-1.0f)))) {
+    *ax = lt_vs(0.0f);
+    *ay = *ax;
+    *az = *ax;
+    return;
+  }
+  lt_oct_decode_v(lt_vlo16(bits), lt_vhi16(bits), ax, ay, az);
+}
+
 // Importance of the (up to four) emitters of a leaf, from their emitter records (`fallback`: see
 // lt_importance_v).
 LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N, int fallback) {
@@ -875,14 +903,14 @@ LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N
   }
   lt_vtranspose(a0, a1, a2, a3); // centre x, y, z, radius
   lt_vtranspose(b0, b1, b2, b3); // axis bits, q, energy, light
-  lt_v4 ax, ay, az;
-  lt_oct_decode_v(lt_vlo16(b0), lt_vhi16(b0), &ax, &ay, &az);
   lt_vm4 spot = lt_vgt(b1, lt_vs(1.5f));
   lt_vm4 plane = lt_vlt(b1, lt_vs(-1.5f)); // one-sided planar: q = -2 - h / r
   lt_v4 cos_o = lt_vsel(lt_vsel(b1, lt_vs(1.0f), spot), lt_vs(LT_PLANE_COS_O), plane);
   lt_v4 cos_e = lt_vsel(zero, lt_vsub(b1, lt_vs(2.0f)), spot);
   lt_v4 plane_h = lt_vsel(lt_vs(LT_PLANE_NONE), lt_vmul(lt_vsub(lt_vs(-2.0f), b1), a3), plane);
   lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
+  lt_v4 ax, ay, az;
+  lt_decode_axes(b0, cos_o, &ax, &ay, &az);
   return lt_fv(
       lt_importance_v(a0, a1, a2, a3, ax, ay, az, cos_o, cos_e, b2, plane_h, P, N, fallback));
 }
@@ -892,9 +920,6 @@ LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) 
 
 LT_HOT float4 lt_node_importance_f(const LtTree* t, int node, float3 P, float3 N, int fallback) {
   GLOBAL const float4* n = t->nodes + node * LT_NODE_F4;
-  lt_v4 axis = lt_vld(n + LT_AXIS);
-  lt_v4 ax, ay, az;
-  lt_oct_decode_v(lt_vlo16(axis), lt_vhi16(axis), &ax, &ay, &az);
   lt_v4 r = lt_vld(n + LT_R);
   lt_v4 cos_o = lt_vld(n + LT_COS_O);
   lt_v4 k16 = lt_vlo16(lt_vld(n + LT_CE_CV2));
@@ -905,6 +930,8 @@ LT_HOT float4 lt_node_importance_f(const LtTree* t, int node, float3 P, float3 N
               lt_vmul(lt_vsub(k16, lt_vs(32768.0f)), lt_vmul(r, lt_vs(LT_PLANE_H_UNIT))), plane);
   cos_o = lt_vsel(cos_o, lt_vs(LT_PLANE_COS_O), plane);
   lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
+  lt_v4 ax, ay, az;
+  lt_decode_axes(lt_vld(n + LT_AXIS), cos_o, &ax, &ay, &az);
   return lt_fv(lt_importance_v(lt_vld(n + LT_CX), lt_vld(n + LT_CY), lt_vld(n + LT_CZ), r, ax, ay,
                                az, cos_o, cos_e, lt_vld(n + LT_ENERGY), plane_h, P, N, fallback));
 }

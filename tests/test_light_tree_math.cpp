@@ -187,6 +187,51 @@ TEST(LightTreeMath, RngIsUniform) {
   EXPECT_LT(chi2_score(counts, prob, n), 5.0);
 }
 
+TEST(LightTreeMath, FullSphereFastPathMatchesGeneralCode) {
+  // lt_importance_v skips the orientation terms when all four lanes have theta_o = pi. Lanes 0-2
+  // are full-sphere clusters; lane 3 has no energy (so it changes neither the energy nor the
+  // distance normalisation) and either a full-sphere cone (the fast path runs) or a random cone
+  // (the general code runs): lanes 0-2 must come out bit for bit the same.
+  LtRng r = lt_rng_make(21, 3);
+  int differs_from_one = 0;
+  for (int i = 0; i < 20000; ++i) {
+    float3 P = make_float3(lt_rng_next(&r), lt_rng_next(&r), lt_rng_next(&r)) * 4.0f;
+    float3 N = i % 8 == 0 ? make_float3(0, 0, 0) : random_unit(r);
+    float c[3][4], ax[3][4];
+    for (int k = 0; k < 4; ++k) {
+      float3 ck = make_float3(lt_rng_next(&r), lt_rng_next(&r), lt_rng_next(&r)) * 4.0f;
+      float3 a = random_unit(r);
+      c[0][k] = ck.x, c[1][k] = ck.y, c[2][k] = ck.z;
+      ax[0][k] = a.x, ax[1][k] = a.y, ax[2][k] = a.z;
+    }
+    // radii from 0 (points) to large (P often inside); cos(theta_e) 0 (points, spheres), random,
+    // or 1 (theta_e = 0: such a lane cannot contribute)
+    float4 rad = make_float4(0.0f, 0.3f * lt_rng_next(&r), 3.0f * lt_rng_next(&r), 1.0f);
+    float u = lt_rng_next(&r);
+    float4 cos_e = u < 0.5f ? make_float4(0, 0, 0, 0)
+                            : make_float4(lt_rng_next(&r), u < 0.7f ? 1.0f : 0.0f, 0.5f, 0.0f);
+    float4 energy = make_float4(1.0f + lt_rng_next(&r), 1e-3f * lt_rng_next(&r), 5.0f, 0.0f);
+    float4 cx = make_float4(c[0][0], c[0][1], c[0][2], c[0][3]);
+    float4 cy = make_float4(c[1][0], c[1][1], c[1][2], c[1][3]);
+    float4 cz = make_float4(c[2][0], c[2][1], c[2][2], c[2][3]);
+    float4 ax4 = make_float4(ax[0][0], ax[0][1], ax[0][2], ax[0][3]);
+    float4 ay4 = make_float4(ax[1][0], ax[1][1], ax[1][2], ax[1][3]);
+    float4 az4 = make_float4(ax[2][0], ax[2][1], ax[2][2], ax[2][3]);
+    float4 fast = lt_importance4(cx, cy, cz, rad, ax4, ay4, az4, make_float4(-1, -1, -1, -1), cos_e,
+                                 energy, P, N);
+    float co3 = 2.0f * lt_rng_next(&r) - 0.999f; // > -1: not a full sphere
+    float4 general = lt_importance4(cx, cy, cz, rad, ax4, ay4, az4, make_float4(-1, -1, -1, co3),
+                                    cos_e, energy, P, N);
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(float_as_uint_(f4_get(fast, k)), float_as_uint_(f4_get(general, k)))
+          << "lane " << k << " case " << i << ": " << f4_get(fast, k) << " vs "
+          << f4_get(general, k);
+      differs_from_one += f4_get(cos_e, k) >= 1.0f && f4_get(energy, k) > 0.0f;
+    }
+  }
+  EXPECT_GT(differs_from_one, 1000); // the theta_e = 0 lanes were exercised
+}
+
 TEST(LightTreeMath, ImportanceConservativeForSingleEmitters) {
   // One emitter per lane: importance > 0 whenever any point of the emitter clearly contributes.
   std::vector<Light> lights = mixed_lights(4000, 77, 10.0f);
