@@ -738,8 +738,7 @@ LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt
     lt_v4 cos_t = lt_vmul(
         lt_vsub(zero, lt_vadd(lt_vadd(lt_vmul(ax, dx), lt_vmul(ay, dy)), lt_vmul(az, dz))), inv_d);
     // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
-    front =
-        lt_vgt(cos_t, lt_vsub(zero, lt_vadd(lt_vmul(plane_h, inv_d), lt_vs(LT_PLANE_SLOPE))));
+    front = lt_vgt(cos_t, lt_vsub(zero, lt_vadd(lt_vmul(plane_h, inv_d), lt_vs(LT_PLANE_SLOPE))));
     lt_v4 kx = lt_vsub(lt_vmul(ay, dz), lt_vmul(az, dy));
     lt_v4 ky = lt_vsub(lt_vmul(az, dx), lt_vmul(ax, dz));
     lt_v4 kz = lt_vsub(lt_vmul(ax, dy), lt_vmul(ay, dx));
