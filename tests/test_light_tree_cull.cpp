@@ -223,7 +223,11 @@ TEST(LightTreeCull, PointsBehindACeilingOfLightsGetAnEmptyCut) {
     std::vector<Light> lights = quad_grid(f.o, f.u, f.v, 16, 1.0f / 16.0f);
     LightTree t = build_light_tree(lights);
     LtTree view = t.view(lights.data());
-    auto sampler = make_light_sampler("tree-split", lights);
+    // The paper's threshold, which splits the root for these points (a cut that does not split
+    // is one stochastic pick, whose E/d^2 fallback gives a light that contributes 0).
+    LightSamplerOptions split_opt;
+    split_opt.split_threshold = 0.85f;
+    auto sampler = make_light_sampler("tree-split", lights, split_opt);
     float3 c = xyz_of(t.root_sphere);
     ld R = t.root_sphere.w;
     double scale = std::fabs(f.o.x) + std::fabs(f.o.y) + std::fabs(f.o.z) + 3.0;
