@@ -689,6 +689,14 @@ INLINE float4 lt_sphere_of_box(float3 bmin, float3 bmax) {
   return f4_from3(c, r > 0.0f ? r * 1.000001f + 1e-30f : 0.0f);
 }
 
+// |a x d| lane-wise: with 1/|d| the sine of the angle between a unit vector a and d.
+LT_HOT lt_v4 lt_vcross_len(lt_v4 ax, lt_v4 ay, lt_v4 az, lt_v4 dx, lt_v4 dy, lt_v4 dz) {
+  lt_v4 kx = lt_vsub(lt_vmul(ay, dz), lt_vmul(az, dy));
+  lt_v4 ky = lt_vsub(lt_vmul(az, dx), lt_vmul(ax, dz));
+  lt_v4 kz = lt_vsub(lt_vmul(ax, dy), lt_vmul(ay, dx));
+  return lt_vsqrt(lt_vadd(lt_vadd(lt_vmul(kx, kx), lt_vmul(ky, ky)), lt_vmul(kz, kz)));
+}
+
 // ---------------------------------------------------------------- cluster importance (Eq. 3)
 // Importance of four clusters for a shading point P with unit normal N (N = 0: no orientation,
 // e.g. a point in a medium or a two-sided/transmissive surface). Per lane:
@@ -739,13 +747,7 @@ LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt
         lt_vsub(zero, lt_vadd(lt_vadd(lt_vmul(ax, dx), lt_vmul(ay, dy)), lt_vmul(az, dz))), inv_d);
     // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
     front = lt_vgt(cos_t, lt_vsub(zero, lt_vadd(lt_vmul(plane_h, inv_d), lt_vs(LT_PLANE_SLOPE))));
-    lt_v4 kx = lt_vsub(lt_vmul(ay, dz), lt_vmul(az, dy));
-    lt_v4 ky = lt_vsub(lt_vmul(az, dx), lt_vmul(ax, dz));
-    lt_v4 kz = lt_vsub(lt_vmul(ax, dy), lt_vmul(ay, dx));
-    lt_v4 sin_t = lt_vmin(
-        lt_vmul(lt_vsqrt(lt_vadd(lt_vadd(lt_vmul(kx, kx), lt_vmul(ky, ky)), lt_vmul(kz, kz))),
-                inv_d),
-        one);
+    lt_v4 sin_t = lt_vmin(lt_vmul(lt_vcross_len(ax, ay, az, dx, dy, dz), inv_d), one);
     lt_v4 sin_o = lt_vsqrt(lt_vmax(lt_vsub(one, lt_vmul(cos_o, cos_o)), zero));
     // theta - theta_o, clamped at 0
     lt_vm4 within_o = lt_vge(cos_t, cos_o);
@@ -760,13 +762,7 @@ LT_HOT lt_v4 lt_importance_v(lt_v4 cx, lt_v4 cy, lt_v4 cz, lt_v4 r, lt_v4 ax, lt
   if (N.x != 0.0f || N.y != 0.0f || N.z != 0.0f) {
     lt_v4 nx = lt_vs(N.x), ny = lt_vs(N.y), nz = lt_vs(N.z);
     lt_v4 ci = lt_vmul(lt_vadd(lt_vadd(lt_vmul(dx, nx), lt_vmul(dy, ny)), lt_vmul(dz, nz)), inv_d);
-    lt_v4 jx = lt_vsub(lt_vmul(ny, dz), lt_vmul(nz, dy));
-    lt_v4 jy = lt_vsub(lt_vmul(nz, dx), lt_vmul(nx, dz));
-    lt_v4 jz = lt_vsub(lt_vmul(nx, dy), lt_vmul(ny, dx));
-    lt_v4 si = lt_vmin(
-        lt_vmul(lt_vsqrt(lt_vadd(lt_vadd(lt_vmul(jx, jx), lt_vmul(jy, jy)), lt_vmul(jz, jz))),
-                inv_d),
-        one);
+    lt_v4 si = lt_vmin(lt_vmul(lt_vcross_len(nx, ny, nz, dx, dy, dz), inv_d), one);
     cos_i = lt_vsel(lt_vadd(lt_vmul(ci, cos_u), lt_vmul(si, sin_u)), one, lt_vge(ci, cos_u));
     cos_i = lt_vmax(cos_i, zero);
   }
