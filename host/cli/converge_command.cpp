@@ -8,6 +8,7 @@
 #include "scene/scene.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <unistd.h>
 
@@ -76,9 +77,6 @@ struct ConfigResult {
   std::vector<MedianPoint> medians; // by spp, increasing
 };
 
-const std::vector<std::string> kSamplerNames = {"uniform", "power", "tree", "tree-split",
-                                                "exhaustive"};
-
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -97,10 +95,11 @@ SamplerConfig parse_config(const std::string& text, float default_threshold,
       throw SceneError(
           fmt::format("{}: '{}': {} applies to tree samplers only", option, text, kNoOrientSuffix));
   }
-  if (std::find(kSamplerNames.begin(), kSamplerNames.end(), c.sampler) == kSamplerNames.end())
-    throw SceneError(fmt::format("{}: unknown light sampler '{}' (one of uniform, power, tree, "
-                                 "tree-split, exhaustive; tree samplers take -noorient)",
-                                 option, c.sampler));
+  if (std::find(kLightSamplerNames.begin(), kLightSamplerNames.end(), c.sampler) ==
+      kLightSamplerNames.end())
+    throw SceneError(fmt::format("{}: unknown light sampler '{}' (one of {}; tree samplers take "
+                                 "-noorient)",
+                                 option, c.sampler, fmt::join(kLightSamplerNames, ", ")));
   if (colon != std::string::npos) {
     std::string t = text.substr(colon + 1);
     char* end = nullptr;

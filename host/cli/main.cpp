@@ -38,8 +38,6 @@ namespace fs = std::filesystem;
 constexpr int kExitRuntime = 1;
 constexpr int kExitBadInput = 2;
 
-const char* kSamplers[] = {"uniform", "power", "tree", "tree-split", "exhaustive"};
-
 struct RenderArgs {
   std::string scene;
   std::optional<int> spp;
@@ -326,7 +324,8 @@ int main(int argc, char** argv) {
   render->add_option("--png", rargs.png, "Output PNG (default: the EXR path with .png)");
   render->add_option("--seed", rargs.seed, "Random seed (overrides the scene)");
   render->add_option("--light-sampler", rargs.light_sampler, "Light sampler (overrides the scene)")
-      ->check(CLI::IsMember(std::vector<std::string>(std::begin(kSamplers), std::end(kSamplers))));
+      ->check(CLI::IsMember(
+          std::vector<std::string>(kLightSamplerNames.begin(), kLightSamplerNames.end())));
   render
       ->add_option("--split-threshold", rargs.split_threshold,
                    "tree-split threshold in [0, 1] (overrides the scene; 0 never splits)")

@@ -732,6 +732,10 @@ std::string JsonValue::as_string() const {
 }
 
 std::string JsonValue::as_enum(std::initializer_list<std::string_view> allowed) const {
+  return as_enum(std::span<const std::string_view>(allowed.begin(), allowed.size()));
+}
+
+std::string JsonValue::as_enum(std::span<const std::string_view> allowed) const {
   std::string s = as_string();
   for (auto a : allowed)
     if (s == a) return s;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -109,6 +110,7 @@ public:
   bool as_bool() const;
   std::string as_string() const;
   std::string as_enum(std::initializer_list<std::string_view> allowed) const;
+  std::string as_enum(std::span<const std::string_view> allowed) const;
 
   // Vectors: an array of 3 finite numbers.
   float3 as_vec3() const;
