@@ -29,11 +29,7 @@ Scene make_plane_scene(float scale, const std::vector<PointLight>& lights, float
   s.film.width = 24;
   s.film.height = 20;
   s.integrator.max_depth = 2; // a bounce off the plane escapes: it must add nothing
-  MaterialDesc m;
-  m.name = "plane";
-  m.gpu.albedo = f4_from3(albedo, 0.0f);
-  m.gpu.type = MATERIAL_DIFFUSE;
-  s.materials.push_back(m);
+  s.materials.push_back(diffuse_material("plane", albedo));
   float e = 20.0f * scale;
   s.vertices = {make_float3(-e, -e, 0), make_float3(e, -e, 0), make_float3(e, e, 0),
                 make_float3(-e, e, 0)};

@@ -37,11 +37,8 @@ Scene make_scene(float intensity, float height, int film_size, float fov_deg) {
   s.film.width = film_size;
   s.film.height = film_size;
   s.integrator.max_depth = 1;
-  MaterialDesc m;
-  m.name = "plane";
-  m.gpu.albedo = make_float4(float(kAlbedo), float(kAlbedo), float(kAlbedo), 0.0f);
-  m.gpu.type = MATERIAL_DIFFUSE;
-  s.materials.push_back(m);
+  const float a = float(kAlbedo);
+  s.materials.push_back(diffuse_material("plane", make_float3(a, a, a)));
   const float e = 10.0f;
   s.vertices = {make_float3(-e, -e, 0), make_float3(e, -e, 0), make_float3(e, e, 0),
                 make_float3(-e, e, 0)};

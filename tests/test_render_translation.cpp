@@ -55,14 +55,9 @@ Scene make_scene(float T, bool occluder) {
   s.film.width = kFilm;
   s.film.height = kFilm;
   s.integrator.max_depth = 1;
-  MaterialDesc floor_m;
-  floor_m.name = "floor";
-  floor_m.gpu.albedo = make_float4(float(kAlbedo), float(kAlbedo), float(kAlbedo), 0.0f);
-  floor_m.gpu.type = MATERIAL_DIFFUSE;
-  MaterialDesc black = floor_m;
-  black.name = "black";
-  black.gpu.albedo = make_float4(0, 0, 0, 0);
-  s.materials = {floor_m, black};
+  const float a = float(kAlbedo);
+  s.materials = {diffuse_material("floor", make_float3(a, a, a)),
+                 diffuse_material("black", make_float3(0, 0, 0))};
   // Each triangle has one edge along x and one across it, so a hit point's x is one rounding of
   // v0.x + u * e.x (cl/geometry.h primitive_hit_point).
   auto add_rect = [&](double x0, double x1, double y0, double y1, double z, int material) {

@@ -34,11 +34,8 @@ Scene make_scene(float cx, float cy, float half, float h, const std::vector<Ligh
   s.film.width = 4;
   s.film.height = 4;
   s.integrator.max_depth = 2;
-  MaterialDesc m;
-  m.name = "plane";
-  m.gpu.albedo = make_float4(float(kAlbedo), float(kAlbedo), float(kAlbedo), 0.0f);
-  m.gpu.type = MATERIAL_DIFFUSE;
-  s.materials.push_back(m);
+  const float a = float(kAlbedo);
+  s.materials.push_back(diffuse_material("plane", make_float3(a, a, a)));
   float e = 1e4f;
   s.vertices = {make_float3(-e, -e, 0), make_float3(e, -e, 0), make_float3(e, e, 0),
                 make_float3(-e, e, 0)};

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace canopy {
@@ -78,6 +79,16 @@ struct MaterialDesc {
   std::string name;
   Material gpu; // device record: type + albedo
 };
+
+// A diffuse (Lambertian) material with reflectance `albedo` per RGB channel.
+inline MaterialDesc diffuse_material(std::string name, float3 albedo) {
+  MaterialDesc d;
+  d.name = std::move(name);
+  d.gpu = Material{};
+  d.gpu.albedo = make_float4(albedo.x, albedo.y, albedo.z, 0.0f);
+  d.gpu.type = MATERIAL_DIFFUSE;
+  return d;
+}
 
 // All geometry flattened into one world-space triangle soup. Emissive mesh triangles (OBJ/MTL Ke
 // or an emission given in the scene) have a TRIANGLE light with LIGHT_FLAG_FROM_MESH and

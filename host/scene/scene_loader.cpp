@@ -67,11 +67,7 @@ int Builder::mtl_material(const std::string& mtl_file, const std::string& name, 
   if (auto it = material_by_name.find(name); it != material_by_name.end()) return it->second;
   std::string key = mtl_file + "\n" + name;
   if (auto it = mtl_material_by_key.find(key); it != mtl_material_by_key.end()) return it->second;
-  MaterialDesc d;
-  d.name = name;
-  d.gpu = Material{};
-  d.gpu.albedo = make_float4(kd.x, kd.y, kd.z, 0.0f);
-  d.gpu.type = MATERIAL_DIFFUSE;
+  MaterialDesc d = diffuse_material(name, kd);
   int idx = int(scene.materials.size());
   scene.materials.push_back(d);
   mtl_material_by_key.emplace(key, idx);
@@ -200,12 +196,7 @@ void parse_materials(const JsonValue& v, Builder& b) {
     std::string name = nv.as_string();
     if (name.empty()) nv.fail("must not be empty");
     if (auto t = o.get("type")) t->as_enum({"diffuse"});
-    MaterialDesc d;
-    d.name = name;
-    d.gpu = Material{};
-    d.gpu.type = MATERIAL_DIFFUSE;
-    float3 a = o.req("albedo").as_albedo();
-    d.gpu.albedo = make_float4(a.x, a.y, a.z, 0.0f);
+    MaterialDesc d = diffuse_material(name, o.req("albedo").as_albedo());
     if (name == "default" && !default_replaced) {
       s.materials[0] = d; // replaces the built-in default
       default_replaced = true;
@@ -245,12 +236,7 @@ Scene load_from_string(const std::string& json_text, const std::string& name,
   parse_json(json_text, name, doc);
   Scene scene;
   scene.path = name;
-  MaterialDesc def;
-  def.name = "default";
-  def.gpu = Material{};
-  def.gpu.albedo = make_float4(0.8f, 0.8f, 0.8f, 0.0f);
-  def.gpu.type = MATERIAL_DIFFUSE;
-  scene.materials.push_back(def);
+  scene.materials.push_back(diffuse_material("default", make_float3(0.8f, 0.8f, 0.8f)));
 
   Builder b{scene, name, base_dir, {}, {}, {}};
   b.material_by_name["default"] = 0;
