@@ -12,11 +12,16 @@
 #define HAS_LIGHT_QUAD 1
 #define HAS_LIGHT_TRIANGLE 1
 #define HAS_PRIM_SPHERE 1
+#define HAS_MATERIAL_CONDUCTOR 1
+#define HAS_MATERIAL_PLASTIC 1
 #endif
 
 // `x` has type T and the kernel has feature T: folds to 0 when the feature is off. (A ternary:
 // `HAS_T && ...` inside || draws clang's -Wconstant-logical-operand in the kernel build.)
 #define IS_LIGHT(l, T) (HAS_##T ? (l)->type == T : 0)
 #define IS_PRIM(p, T) (HAS_##T ? (p)->type == T : 0)
+#define IS_MATERIAL(m, T) (HAS_##T ? (m)->type == T : 0)
+// GGX code (cl/bsdf/microfacet.h) is compiled only for scenes with a glossy material.
+#define HAS_MICROFACET (HAS_MATERIAL_CONDUCTOR || HAS_MATERIAL_PLASTIC)
 
 #endif // CANOPY_CL_FEATURES_H

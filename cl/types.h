@@ -35,12 +35,20 @@ typedef struct Light {
 } Light;
 
 // ---------------------------------------------------------------- materials
-#define MATERIAL_DIFFUSE 0
+// Every glossy material uses GGX with alpha = roughness^2 (cl/bsdf/). alpha == 0 makes the glossy
+// lobe a perfect mirror (a delta lobe: light sampling skips it).
+#define MATERIAL_DIFFUSE 0   // Lambertian: albedo / pi
+#define MATERIAL_CONDUCTOR 1 // GGX microfacet with the exact conductor Fresnel of eta + i k
+#define MATERIAL_PLASTIC 2   // albedo / pi + specular * GGX with dielectric Fresnel (pbrt-v3)
 
 typedef struct Material {
-  float4 albedo; // rgb reflectance in [0,1]
-  int type;
-  int pad0, pad1, pad2;
+  float4 albedo;   // diffuse, plastic: diffuse reflectance rgb in [0,1]
+  float4 specular; // plastic: specular scale rgb; conductor: eta (real part of the index) rgb
+  float4 k;        // conductor: k (imaginary part of the index) rgb
+  float alpha;     // conductor, plastic: GGX alpha = roughness^2 (0: perfect specular)
+  float ior;       // plastic: index of refraction of the coat
+  int type;        // MATERIAL_*
+  int pad;
 } Material;
 
 // ---------------------------------------------------------------- geometry / BVH

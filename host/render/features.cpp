@@ -26,6 +26,7 @@ KernelFeatures KernelFeatures::all(int light_sampler) {
   KernelFeatures f;
   f.light_point = f.light_spot = f.light_sphere = f.light_quad = f.light_triangle = true;
   f.prim_sphere = true;
+  f.material_conductor = f.material_plastic = true;
   f.light_sampler = light_sampler;
   return f;
 }
@@ -33,9 +34,11 @@ KernelFeatures KernelFeatures::all(int light_sampler) {
 std::string KernelFeatures::build_options() const {
   return fmt::format("-DCANOPY_FEATURES_SET -DHAS_LIGHT_POINT={} -DHAS_LIGHT_SPOT={} "
                      "-DHAS_LIGHT_SPHERE={} -DHAS_LIGHT_QUAD={} -DHAS_LIGHT_TRIANGLE={} "
-                     "-DHAS_PRIM_SPHERE={} -DCANOPY_LIGHT_SAMPLER={}",
+                     "-DHAS_PRIM_SPHERE={} -DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} "
+                     "-DCANOPY_LIGHT_SAMPLER={}",
                      int(light_point), int(light_spot), int(light_sphere), int(light_quad),
-                     int(light_triangle), int(prim_sphere), light_sampler);
+                     int(light_triangle), int(prim_sphere), int(material_conductor),
+                     int(material_plastic), light_sampler);
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {
@@ -61,6 +64,10 @@ KernelFeatures scene_features(const Scene& scene, int light_sampler) {
     default:
       break;
     }
+  }
+  for (const MaterialDesc& m : scene.materials) {
+    f.material_conductor |= m.gpu.type == MATERIAL_CONDUCTOR;
+    f.material_plastic |= m.gpu.type == MATERIAL_PLASTIC;
   }
   return f;
 }

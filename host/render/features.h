@@ -12,6 +12,7 @@ struct KernelFeatures {
   bool light_point = false, light_spot = false, light_sphere = false, light_quad = false,
        light_triangle = false;
   bool prim_sphere = false;
+  bool material_conductor = false, material_plastic = false;
   int light_sampler = 0; // SAMPLER_* (cl/types.h)
 
   // Everything on (for the test that checks specialisation changes nothing).
