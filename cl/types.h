@@ -120,5 +120,6 @@ typedef struct SplitItem {
 #define SAMPLER_TREE 2
 #define SAMPLER_TREE_SPLIT 3
 #define SAMPLER_EXHAUSTIVE 4
+#define SAMPLER_BSDF 5 // no light sampling: emission is found by BSDF-sampled rays alone
 
 #endif // CANOPY_CL_TYPES_H

@@ -85,6 +85,7 @@ struct RendererOptions {
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD;
   int max_cut = kDefaultMaxCut;       // cut size cap per shading point (tree-split)
   bool orientation_term = true;       // tree samplers: false = E / d^2 importance (ablation)
+  bool mis = true;                    // false: no MIS (light sampling alone for non-delta bounces)
   bool all_features = false;          // compile every kernel feature (tests)
   size_t split_queue_items = 1 << 20; // split-queue capacity per wave
 };

@@ -73,6 +73,9 @@ struct IntegratorSettings {
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD; // adaptive splitting threshold in [0, 1]
   int max_cut = kDefaultMaxCut; // tree-split: at most this many lights per shading point
   uint32_t seed = 1;
+  // MIS (power heuristic) between light and BSDF sampling; false: light sampling alone counts
+  // emission from non-delta bounces (the ablation of docs/results.md).
+  bool mis = true;
 };
 
 struct MaterialDesc {
