@@ -103,7 +103,7 @@ typedef struct ShadowItem {
 } ShadowItem;
 
 // A cluster of lights waiting in the split queue (Conty Estevez & Kulla 2018, Alg. 3 unrolled into
-// passes): `code` is a light-tree node or leaf (cl/light_tree_math.h), `sphere` and `cv2` its
+// passes): `code` is a light-tree node or leaf (cl/light_tree/layout.h), `sphere` and `cv2` its
 // bounding sphere and energy CV^2 (the split measure's inputs), `budget` the cut size it may still
 // spend.
 typedef struct SplitItem {

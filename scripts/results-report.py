@@ -24,7 +24,7 @@ SCENES = [
     ("plane-10k", "10,000 point lights over a diffuse plane (pbrt-v4's many-light test; "
                   "scripts/gen-plane-lights.py)"),
 ]
-# The default split threshold (LT_DEFAULT_SPLIT_THRESHOLD in cl/light_tree_math.h).
+# The default split threshold (LT_DEFAULT_SPLIT_THRESHOLD in cl/light_tree/split.h).
 DEFAULT_THRESHOLD = "tree-split:0.25"
 THRESHOLDS = ["tree-split:0.0", "tree-split:0.25", "tree-split:0.5", "tree-split:0.85", "tree-split:0.95"]
 

@@ -1,4 +1,4 @@
-// Exact culling of one-sided planar emitters (cl/light_tree_math.h, LT_PLANE_SLOPE): the
+// Exact culling of one-sided planar emitters (cl/light_tree/layout.h, LT_PLANE_SLOPE): the
 // importance of a leaf emitter or of a node lane is 0 wherever no emitter below it can send light
 // to P (checked against the vertices in long double, the renderer's emission test being
 // dot(n, P - x) > 0), and it is exactly 0 for points behind the plane by more than the bound's

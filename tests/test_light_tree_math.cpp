@@ -1,4 +1,4 @@
-// Shared light-tree math (cl/light_tree_math.h) on the host: cone union, M_Omega, the stable
+// Shared light-tree math (cl/light_tree/) on the host: cone union, M_Omega, the stable
 // geometric variance, the dimensionless split measure and the importance's scale invariance.
 #include "test_light_tree_util.h"
 

@@ -4,7 +4,8 @@
 #ifndef CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 #define CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 
-#include "../light_tree_math.h"
+#include "../light_tree/pmf.h"
+#include "../light_tree/traverse.h"
 #include "../types.h"
 
 typedef struct LightSamplerCtx {
@@ -31,7 +32,7 @@ INLINE SplitItem light_sampler_root(const LightSamplerCtx* ls, int path) {
 }
 
 // Picks one light among all of them (uniform, power) or below `code` (tree) with random words
-// from rng, each choice with exactly the probability it reports (cl/light_tree_math.h, "exact
+// from rng, each choice with exactly the probability it reports (cl/light_tree/rng.h, "exact
 // discrete choices"). Returns the light or -1; *pmf its probability. The host samplers
 // (host/lighttree/light_sampler.cpp) run the same functions.
 INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, float3 N, LtRng* rng,

@@ -10,6 +10,9 @@
 // behind the shading point's horizon or outside their emission cone: zero contribution).
 #pragma once
 
+#include "light_tree/pmf.h"      // cl/
+#include "light_tree/split.h"    // cl/
+#include "light_tree/traverse.h" // cl/
 #include "lighttree/light_tree.h"
 
 #include <cstdint>
@@ -19,7 +22,7 @@
 
 namespace canopy {
 
-// Counter-based random stream (cl/light_tree_math.h), the same struct in kernels.
+// Counter-based random stream (cl/light_tree/rng.h), the same struct in kernels.
 using Rng = LtRng;
 inline Rng make_rng(uint32_t seed, uint32_t stream) {
   return lt_rng_make(seed, stream);
@@ -65,7 +68,7 @@ protected:
 };
 
 // Vose alias table over non-negative weights (built in double); all-zero (or empty) weights give a
-// uniform table. Sampling runs lt_alias_pick (cl/light_tree_math.h), the device's function.
+// uniform table. Sampling runs lt_alias_pick (cl/light_tree/rng.h), the device's function.
 class AliasTable {
 public:
   AliasTable() = default;

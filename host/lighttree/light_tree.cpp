@@ -693,6 +693,9 @@ LtTree LightTree::view(const Light* lights) const {
 }
 
 namespace {
+inline float4 splat4(float s) {
+  return make_float4(s, s, s, s);
+}
 inline void set_lane_value(float4& v, int lane, float x) {
   (lane == 0 ? v.x : lane == 1 ? v.y : lane == 2 ? v.z : v.w) = x;
 }
@@ -711,7 +714,7 @@ uint32_t oct_encode(float3 a, double* err) {
   double cu = std::clamp(std::nearbyint((double(px) + 1.0) * 0.5 * 65535.0), 0.0, 65535.0);
   double cv = std::clamp(std::nearbyint((double(py) + 1.0) * 0.5 * 65535.0), 0.0, 65535.0);
   float4 ax, ay, az;
-  lt_oct_decode4(lt_splat4(float(cu)), lt_splat4(float(cv)), &ax, &ay, &az);
+  lt_oct_decode4(splat4(float(cu)), splat4(float(cv)), &ax, &ay, &az);
   // angle from the chord between the two (unit up to rounding) vectors, plus that rounding
   double dx = double(ax.x) - a.x, dy = double(ay.x) - a.y, dz = double(az.x) - a.z;
   double chord = std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -728,7 +731,7 @@ inline float float_down(double x) {
 // The unit vector that octahedral bits decode to on the device (lt_oct_decode_v).
 float3 oct_decode(uint32_t bits) {
   float4 ax, ay, az;
-  lt_oct_decode4(lt_splat4(float(bits & 0xffffu)), lt_splat4(float(bits >> 16)), &ax, &ay, &az);
+  lt_oct_decode4(splat4(float(bits & 0xffffu)), splat4(float(bits >> 16)), &ax, &ay, &az);
   return make_float3(ax.x, ay.x, az.x);
 }
 double chord(float3 a, float3 b) {
@@ -743,7 +746,7 @@ double chord_angle(double c) {
 // half-space bound (LT_PLANE_SLOPE covers it plus the test's rounding, LT_PLANE_ROUND).
 constexpr double kPlaneAngle = double(LT_PLANE_SLOPE) - double(LT_PLANE_ROUND);
 
-// The emitter record of one emitter (LT_EMITTER_F4 float4, see cl/light_tree_math.h): sphere;
+// The emitter record of one emitter (LT_EMITTER_F4 float4, see cl/light_tree/layout.h): sphere;
 // (octahedral axis bits, q, energy, light index). q packs the cone: q <= 1: cos(theta_o) with
 // theta_e = pi/2; q > 1.5: theta_o = 0 and cos(theta_e) = q - 2 (exact); q < -1.5: a one-sided
 // planar emitter, theta_o = LT_PLANE_SLOPE, theta_e = pi/2 and the half-space bound h = (-2 - q) r

@@ -1,8 +1,8 @@
 // Light tree (Conty Estevez & Kulla 2018, §4): emitter bounds, binned SAOH build of a binary tree
 // (parallel, TBB), collapse into the 4-wide struct-of-arrays tree that the host sampler and the
-// kernels traverse with the functions of cl/light_tree_math.h.
+// kernels traverse with the functions of cl/light_tree/ (traverse.h, pmf.h).
 //
-// Device layout (upload each vector as one buffer, as is; see the top of cl/light_tree_math.h):
+// Device layout (upload each vector as one buffer, as is; see the top of cl/light_tree/layout.h):
 //   nodes        float4 x LT_NODE_F4 (8) per 4-wide node: per-lane sphere centre x/y/z, radius,
 //                octahedral cone axis, cos(theta_o), energy, cos(theta_e) | energy CV^2 (16 bits
 //                each; lanes of one-sided planar emitters flag a half-space bound in cos(theta_o)
@@ -18,7 +18,9 @@
 // The traversal reads only nodes and children (and the Light record of the light it returns).
 #pragma once
 
-#include "light_tree_math.h" // cl/: LtCone, LtTree, layout constants
+#include "light_bounds.h"      // cl/: lt_light_bounds, lt_sphere_of_box
+#include "light_tree/cone.h"   // cl/: LtCone
+#include "light_tree/layout.h" // cl/: LtTree, layout constants
 
 #include <cmath>
 #include <cstddef>

@@ -1,6 +1,7 @@
 #include "lighttree/synthetic_lights.h"
 
-#include "light_tree_math.h"
+#include "light_tree/cone.h" // lt_any_perpendicular
+#include "light_tree/rng.h"
 
 #include <cmath>
 

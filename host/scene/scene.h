@@ -3,8 +3,8 @@
 // docs/scene-format.md.
 #pragma once
 
-#include "light_tree_math.h" // LT_DEFAULT_SPLIT_THRESHOLD
-#include "types.h"           // cl/types.h: Light, Material (device layouts)
+#include "light_tree/split.h" // cl/: LT_DEFAULT_SPLIT_THRESHOLD
+#include "types.h"            // cl/types.h: Light, Material (device layouts)
 
 #include <array>
 #include <cstdint>

@@ -1,0 +1,208 @@
+// Importance of clusters and emitters for a shading point (Conty Estevez & Kulla 2018, Eq. 3 with
+// the bounding-sphere angle theta_u of §5.2), four lanes at a time: the lanes of a 4-wide node or
+// the emitters of a leaf, read from the records of layout.h. Also the orientation ablation
+// (LT_TERMS_DISTANCE, the paper's Fig. 15-16). Compiles as OpenCL C and as C++ (cl/compat.h).
+#ifndef CANOPY_LIGHT_TREE_IMPORTANCE_H
+#define CANOPY_LIGHT_TREE_IMPORTANCE_H
+
+#include "../compat.h"
+#include "../simd4.h"
+#include "layout.h"
+
+// Smallest importance given to a lane that can contribute, so underflow never makes it 0 (the
+// importances of the four lanes are normalised by their maximum energy and minimum distance first).
+#define LT_IMPORTANCE_FLOOR 1e-30f
+
+// |a x d| lane-wise: with 1/|d| the sine of the angle between a unit vector a and d.
+LT_HOT v4f lt_vcross_len(v4f ax, v4f ay, v4f az, v4f dx, v4f dy, v4f dz) {
+  v4f kx = v4_sub(v4_mul(ay, dz), v4_mul(az, dy));
+  v4f ky = v4_sub(v4_mul(az, dx), v4_mul(ax, dz));
+  v4f kz = v4_sub(v4_mul(ax, dy), v4_mul(ay, dx));
+  return v4_sqrt(v4_add(v4_add(v4_mul(kx, kx), v4_mul(ky, ky)), v4_mul(kz, kz)));
+}
+
+// ---------------------------------------------------------------- cluster importance (Eq. 3)
+// Importance of four clusters for a shading point P with unit normal N (N = 0: no orientation,
+// e.g. a point in a medium or a two-sided/transmissive surface). Per lane:
+//   E * cos(theta') * max(cos(theta_i'), 0) / max(d^2, (r/2)^2), 0 when theta' >= theta_e,
+// theta' = max(theta - theta_o - theta_u, 0), theta_i' = max(theta_i - theta_u, 0), sin(theta_u) =
+// r/d and theta_u = pi inside the sphere. All angle differences use cos(a-b) = cos a cos b +
+// sin a sin b (no acos). Emitters below the horizon of N are culled (opaque surfaces).
+// Lanes are normalised by the largest energy and the smallest clamped d^2 among the lanes (only
+// ratios matter) and a lane that can contribute gets at least LT_IMPORTANCE_FLOOR: the result is
+// never 0 for a cluster that can contribute and never overflows. A lane whose half-space bound
+// (plane offset h, see LT_PLANE_SLOPE; LT_PLANE_NONE: none) puts P behind all its one-sided planar
+// emitters is 0 whatever its sphere, P inside it included. If no lane can contribute and
+// `fallback` is set (stochastic descents), lanes with energy get E/d^2 (see below); only lanes
+// without energy are ever 0 then. Without `fallback` (splitting) such lanes stay 0.
+LT_HOT v4f lt_importance_v(v4f cx, v4f cy, v4f cz, v4f r, v4f ax, v4f ay, v4f az, v4f cos_o,
+                           v4f cos_e, v4f energy, v4f plane_h, float3 P, float3 N, int fallback) {
+  v4f zero = v4_splat(0.0f);
+  v4f one = v4_splat(1.0f);
+  v4f dx = v4_sub(cx, v4_splat(P.x));
+  v4f dy = v4_sub(cy, v4_splat(P.y));
+  v4f dz = v4_sub(cz, v4_splat(P.z));
+  v4f d2 = v4_add(v4_add(v4_mul(dx, dx), v4_mul(dy, dy)), v4_mul(dz, dz));
+  v4f r2 = v4_mul(r, r);
+  v4m inside = v4_le(d2, r2);
+  v4f d2c = v4_max(v4_max(d2, v4_mul(r2, v4_splat(0.25f))), v4_splat(1e-36f));
+  // Every cosine and sine below is a dot or cross product scaled by 1/d, so the square roots run
+  // side by side instead of one after the other (the latency of this function bounds a descent).
+  v4f inv_d = v4_div(one, v4_sqrt(v4_max(d2, v4_splat(1e-36f))));
+  // theta_u: half-angle of the cone from P around the bounding sphere
+  v4f sin_u = v4_min(v4_mul(r, inv_d), one);
+  v4f cos_u = v4_min(v4_mul(v4_sqrt(v4_max(v4_sub(d2, r2), zero)), inv_d), one);
+  sin_u = v4_sel(sin_u, zero, inside);
+  cos_u = v4_sel(cos_u, v4_splat(-1.0f), inside);
+  // Fast path: four full-sphere cones (theta_o = pi: points, spheres, two-sided emitters and
+  // their clusters, every lane under LT_TERMS_DISTANCE) bound every direction, theta' = 0 and
+  // cos(theta') = 1; for finite P the general code gives exactly the same (c1 = 1, s1 = 0, c2 = 1)
+  // at the cost of the axis (lt_decode_axes: not even decoded) and a third of this function.
+  // Full-sphere lanes never carry a half-space bound, so `front` is all true there.
+  v4f orient;
+  v4m full = v4_le(cos_o, v4_splat(-1.0f));
+  v4m front = full;
+  if (v4_all(full)) {
+    orient = v4_sel(zero, one, v4_gt(one, cos_e));
+  } else {
+    // theta: angle between the cone axis and the direction from the cluster towards P
+    v4f cos_t =
+        v4_mul(v4_sub(zero, v4_add(v4_add(v4_mul(ax, dx), v4_mul(ay, dy)), v4_mul(az, dz))), inv_d);
+    // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
+    front = v4_gt(cos_t, v4_sub(zero, v4_add(v4_mul(plane_h, inv_d), v4_splat(LT_PLANE_SLOPE))));
+    v4f sin_t = v4_min(v4_mul(lt_vcross_len(ax, ay, az, dx, dy, dz), inv_d), one);
+    v4f sin_o = v4_sqrt(v4_max(v4_sub(one, v4_mul(cos_o, cos_o)), zero));
+    // theta - theta_o, clamped at 0
+    v4m within_o = v4_ge(cos_t, cos_o);
+    v4f c1 = v4_sel(v4_add(v4_mul(cos_t, cos_o), v4_mul(sin_t, sin_o)), one, within_o);
+    v4f s1 = v4_sel(v4_sub(v4_mul(sin_t, cos_o), v4_mul(cos_t, sin_o)), zero, within_o);
+    // minus theta_u, clamped at 0
+    v4f c2 = v4_sel(v4_add(v4_mul(c1, cos_u), v4_mul(s1, sin_u)), one, v4_ge(c1, cos_u));
+    orient = v4_sel(zero, c2, v4_gt(c2, cos_e));
+  }
+  // incidence at P
+  v4f cos_i = one;
+  if (N.x != 0.0f || N.y != 0.0f || N.z != 0.0f) {
+    v4f nx = v4_splat(N.x), ny = v4_splat(N.y), nz = v4_splat(N.z);
+    v4f ci = v4_mul(v4_add(v4_add(v4_mul(dx, nx), v4_mul(dy, ny)), v4_mul(dz, nz)), inv_d);
+    v4f si = v4_min(v4_mul(lt_vcross_len(nx, ny, nz, dx, dy, dz), inv_d), one);
+    cos_i = v4_sel(v4_add(v4_mul(ci, cos_u), v4_mul(si, sin_u)), one, v4_ge(ci, cos_u));
+    cos_i = v4_max(cos_i, zero);
+  }
+  v4m alive = v4_gt(energy, zero);
+  float emax = v4_hmax(energy);
+  float dmin2 = v4_hmin(v4_sel(v4_splat(3.0e38f), d2c, alive));
+  float inv_emax = emax > 0.0f ? 1.0f / emax : 0.0f;
+  v4f e = v4_mul(energy, v4_splat(inv_emax));
+  v4f g = v4_div(v4_splat(dmin2), d2c);
+  v4f oc = v4_mul(orient, cos_i);
+  v4f imp = v4_mul(v4_mul(e, g), oc);
+  v4m contributes = v4_and(v4_and(alive, v4_gt(oc, zero)), front);
+  v4f res = v4_sel(zero, v4_max(imp, v4_splat(LT_IMPORTANCE_FLOOR)), contributes);
+  // No lane can contribute but some has energy (bounds of the parent were looser than those of
+  // its children): rank by energy and distance alone, so a descent never dead-ends and the pmf
+  // sums to 1 over the lights with energy. Such picks contribute 0, which keeps them unbiased.
+  if (fallback && !(v4_sum(res) > 0.0f) && emax > 0.0f)
+    res = v4_sel(zero, v4_max(v4_mul(e, g), v4_splat(LT_IMPORTANCE_FLOOR)), alive);
+  return res;
+}
+LT_HOT float4 lt_importance4(float4 cx, float4 cy, float4 cz, float4 r, float4 ax, float4 ay,
+                             float4 az, float4 cos_o, float4 cos_e, float4 energy, float3 P,
+                             float3 N) {
+  return v4_to_f4(lt_importance_v(v4_from_f4(cx), v4_from_f4(cy), v4_from_f4(cz), v4_from_f4(r),
+                                  v4_from_f4(ax), v4_from_f4(ay), v4_from_f4(az), v4_from_f4(cos_o),
+                                  v4_from_f4(cos_e), v4_from_f4(energy), v4_splat(LT_PLANE_NONE), P,
+                                  N, 1));
+}
+
+// every direction (cos theta' = 1), N = 0 drops the receiver's incidence term, and no half-space
+// bound culls (it is an orientation term too).
+INLINE void lt_without_orientation(const LtTree* t, v4f* cos_o, v4f* cos_e, v4f* plane_h,
+                                   float3* N) {
+  if (t->root_info.w == LT_TERMS_FULL) return;
+  *cos_o = v4_splat(-1.0f);
+  *cos_e = v4_splat(-1.0f);
+  *plane_h = v4_splat(LT_PLANE_NONE);
+  *N = make_float3(0.0f, 0.0f, 0.0f);
+}
+
+// The cone axes of four lanes from their octahedral bits, decoded only if some lane's cone is not
+// the full sphere (cos_o = -1): lt_importance_v ignores the axes of four full-sphere lanes.
+LT_HOT void lt_decode_axes(v4f bits, v4f cos_o, v4f* ax, v4f* ay, v4f* az) {
+  if (v4_all(v4_le(cos_o, v4_splat(-1.0f)))) {
+    *ax = v4_splat(0.0f);
+    *ay = *ax;
+    *az = *ax;
+    return;
+  }
+  lt_oct_decode_v(v4_lo16(bits), v4_hi16(bits), ax, ay, az);
+}
+
+// Importance of the (up to four) emitters of a leaf, from their emitter records (`fallback`: see
+// lt_importance_v).
+LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N, int fallback) {
+  int count = lt_leaf_count(code);
+  GLOBAL const float4* e = lt_emitter_records(t, lt_leaf_first(code));
+  v4f zero = v4_splat(0.0f);
+  v4f a0 = v4_load(e), b0 = v4_load(e + 1);
+  v4f a1 = zero, b1 = zero, a2 = zero, b2 = zero, a3 = zero, b3 = zero;
+  if (count > 1) {
+    a1 = v4_load(e + 2);
+    b1 = v4_load(e + 3);
+  }
+  if (count > 2) {
+    a2 = v4_load(e + 4);
+    b2 = v4_load(e + 5);
+  }
+  if (count > 3) {
+    a3 = v4_load(e + 6);
+    b3 = v4_load(e + 7);
+  }
+  v4_transpose(a0, a1, a2, a3); // centre x, y, z, radius
+  v4_transpose(b0, b1, b2, b3); // axis bits, q, energy, light
+  v4m spot = v4_gt(b1, v4_splat(1.5f));
+  v4m plane = v4_lt(b1, v4_splat(-1.5f)); // one-sided planar: q = -2 - h / r
+  v4f cos_o = v4_sel(v4_sel(b1, v4_splat(1.0f), spot), v4_splat(LT_PLANE_COS_O), plane);
+  v4f cos_e = v4_sel(zero, v4_sub(b1, v4_splat(2.0f)), spot);
+  v4f plane_h = v4_sel(v4_splat(LT_PLANE_NONE), v4_mul(v4_sub(v4_splat(-2.0f), b1), a3), plane);
+  lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
+  v4f ax, ay, az;
+  lt_decode_axes(b0, cos_o, &ax, &ay, &az);
+  return v4_to_f4(
+      lt_importance_v(a0, a1, a2, a3, ax, ay, az, cos_o, cos_e, b2, plane_h, P, N, fallback));
+}
+LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) {
+  return lt_leaf_importance_f(t, code, P, N, 1);
+}
+
+LT_HOT float4 lt_node_importance_f(const LtTree* t, int node, float3 P, float3 N, int fallback) {
+  GLOBAL const float4* n = t->nodes + node * LT_NODE_F4;
+  v4f r = v4_load(n + LT_R);
+  v4f cos_o = v4_load(n + LT_COS_O);
+  v4f k16 = v4_lo16(v4_load(n + LT_CE_CV2));
+  v4m plane = v4_gt(cos_o, v4_splat(1.5f)); // LT_PLANE_FLAG: k16 is the plane offset
+  v4f cos_e = v4_sel(v4_mul(k16, v4_splat(LT_U16_SCALE)), v4_splat(0.0f), plane);
+  v4f plane_h =
+      v4_sel(v4_splat(LT_PLANE_NONE),
+             v4_mul(v4_sub(k16, v4_splat(32768.0f)), v4_mul(r, v4_splat(LT_PLANE_H_UNIT))), plane);
+  cos_o = v4_sel(cos_o, v4_splat(LT_PLANE_COS_O), plane);
+  lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
+  v4f ax, ay, az;
+  lt_decode_axes(v4_load(n + LT_AXIS), cos_o, &ax, &ay, &az);
+  return v4_to_f4(lt_importance_v(v4_load(n + LT_CX), v4_load(n + LT_CY), v4_load(n + LT_CZ), r, ax,
+                                  ay, az, cos_o, cos_e, v4_load(n + LT_ENERGY), plane_h, P, N,
+                                  fallback));
+}
+LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) {
+  return lt_node_importance_f(t, node, P, N, 1);
+}
+
+// Importances of the four lanes below `code` (a node or a leaf) for the split decisions: without
+// the fallback, so a cluster splits into exactly the lanes that can contribute (none where P sees
+// no emitter of the cluster: a point behind a ceiling of one-sided lights gets an empty cut).
+INLINE float4 lt_code_importance(const LtTree* t, int code, float3 P, float3 N) {
+  return code >= 0 ? lt_node_importance_f(t, code, P, N, 0)
+                   : lt_leaf_importance_f(t, code, P, N, 0);
+}
+
+#endif // CANOPY_LIGHT_TREE_IMPORTANCE_H
