@@ -1,6 +1,6 @@
-// Bounds of one emitter for the light tree, per light type (Conty Estevez & Kulla 2018, Table 1
-// and §5.1): bounding box, orientation cone (as cosines) and energy, and the bounding sphere of a
-// box. Compiles as OpenCL C and as C++ (cl/compat.h).
+// Bounds of one emitter for the light tree, per light type (Conty Estevez & Kulla 2018, §4.1
+// and Table 1; the energy as in §5.1): bounding box, orientation cone (as cosines) and energy, and
+// the bounding sphere of a box. Compiles as OpenCL C and as C++ (cl/compat.h).
 #ifndef CANOPY_LIGHT_BOUNDS_H
 #define CANOPY_LIGHT_BOUNDS_H
 

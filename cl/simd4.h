@@ -3,10 +3,10 @@
 // host (the float4 struct of compat.h would go through memory) and the compat.h float4 struct on
 // other hosts. Every operation is the same IEEE operation lane by lane, in the same order, on
 // every backend, so host and device compute identical bits. The light tree's hot path (four
-// children of a 4-wide node at once; Conty Estevez & Kulla 2018, §4 and Eq. 3) is written with it;
-// values stored or returned to scalar code are float4 (v4_from_f4 / v4_to_f4 convert).
-// Also here: scalar min/max/clamp, the horizontal sum of a float4 in the lanes' order, and the
-// LT_HOT / LT_PREFETCH compiler hints.
+// children of a 4-wide node at once; the importance of Conty Estevez & Kulla 2018, §5.1, Eq. 3) is
+// written with it; values stored or returned to scalar code are float4 (v4_from_f4 / v4_to_f4
+// convert). Also here: scalar min/max/clamp, the horizontal sum of a float4 in the lanes' order,
+// and the LT_HOT / LT_PREFETCH compiler hints.
 #ifndef CANOPY_SIMD4_H
 #define CANOPY_SIMD4_H
 

@@ -1,7 +1,7 @@
 // Orientation cones of emitters and clusters (Conty Estevez & Kulla 2018, §4.1): the cone
 // (axis, theta_o normal bound, theta_e emission bound), the union of two cones (Alg. 1) and the
-// orientation measure M_Omega (Eq. 1) of the build's SAOH cost. Used by the tree build (host);
-// compiles as OpenCL C and as C++ (cl/compat.h).
+// orientation measure M_Omega (§4.3, Eq. 1) of the build's SAOH cost (§4.4, Eq. 2). Used by the
+// tree build (host); compiles as OpenCL C and as C++ (cl/compat.h).
 #ifndef CANOPY_LIGHT_TREE_CONE_H
 #define CANOPY_LIGHT_TREE_CONE_H
 

@@ -1,5 +1,5 @@
-// Importance of clusters and emitters for a shading point (Conty Estevez & Kulla 2018, Eq. 3 with
-// the bounding-sphere angle theta_u of §5.2), four lanes at a time: the lanes of a 4-wide node or
+// Importance of clusters and emitters for a shading point (Conty Estevez & Kulla 2018, §5.1, Eq. 3;
+// theta_u from the bounding sphere, Fig. 7), four lanes at a time: the lanes of a 4-wide node or
 // the emitters of a leaf, read from the records of layout.h. Also the orientation ablation
 // (LT_TERMS_DISTANCE, the paper's Fig. 15-16). Compiles as OpenCL C and as C++ (cl/compat.h).
 #ifndef CANOPY_LIGHT_TREE_IMPORTANCE_H

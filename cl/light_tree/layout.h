@@ -1,6 +1,6 @@
-// The light tree's device layout (Conty Estevez & Kulla 2018, §4: a BVH of lights whose nodes hold
-// bounding spheres, orientation cones and energies), the view LtTree the samplers read it through,
-// leaf codes, emitter records and the octahedral decoding of cone axes. The build is
+// The light tree's device layout (Conty Estevez & Kulla 2018, §4.1-4.2: a BVH of lights whose nodes
+// hold bounding spheres, orientation cones and energies), the view LtTree the samplers read it
+// through, leaf codes, emitter records and the octahedral decoding of cone axes. The build is
 // host/lighttree/light_tree.cpp; importance.h, traverse.h, split.h and pmf.h read it. Compiles as
 // OpenCL C and as C++ (cl/compat.h).
 //

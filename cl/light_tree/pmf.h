@@ -1,7 +1,7 @@
 // Probability that the light-tree samplers produce a given light, recomputed along its bit-trail
 // with the same functions as the sampling: the stochastic descent (Conty Estevez & Kulla 2018,
-// Alg. 2) and splitting (Alg. 3), for MIS when a BSDF ray hits a light (DESIGN §4). Compiles as
-// OpenCL C and as C++ (cl/compat.h).
+// §5.3, Alg. 2) and splitting (§5.4, Alg. 3), for MIS when a BSDF ray hits a light (DESIGN §4).
+// Compiles as OpenCL C and as C++ (cl/compat.h).
 #ifndef CANOPY_LIGHT_TREE_PMF_H
 #define CANOPY_LIGHT_TREE_PMF_H
 

@@ -1,5 +1,5 @@
-// Stochastic descent of the light tree to one light (Conty Estevez & Kulla 2018, Alg. 2): at each
-// node one child lane with probability proportional to its importance (importance.h, Eq. 3),
+// Stochastic descent of the light tree to one light (Conty Estevez & Kulla 2018, §5.3, Alg. 2): at
+// each node one child lane with probability proportional to its importance (importance.h, Eq. 3),
 // chosen exactly (rng.h). Its pmf is lt_pmf_below (pmf.h). Compiles as OpenCL C and as C++.
 #ifndef CANOPY_LIGHT_TREE_TRAVERSE_H
 #define CANOPY_LIGHT_TREE_TRAVERSE_H
