@@ -211,7 +211,7 @@ void BM_PickCpu(benchmark::State& state) {
 
 const char* kDevicePickKernel = R"CL(
 #include "kernels/params.h"
-__kernel void pick_bench(LIGHT_SAMPLER_PARAMS, __global const float4* P, __global const float4* N,
+__kernel void pick_bench(LIGHT_SAMPLER_PARAMS __global const float4* P, __global const float4* N,
                          uint seed, int count, __global int* out) {
   int i = get_global_id(0);
   if (i >= count) return;
@@ -235,32 +235,28 @@ void BM_DevicePick(benchmark::State& state) {
     N[i] = f4_from3(pts[i].N, 0.0f);
   }
   ClRuntime rt;
-  cl::Program program(rt.context(), kDevicePickKernel);
-  std::string opts = "-I " + kernel_dir().string() +
-                     " -cl-std=CL1.2 -DCANOPY_LIGHT_SAMPLER=" + std::to_string(data.kind);
-  program.build({rt.device()}, opts.c_str());
+  cl::Program program = rt.build_program_source(kDevicePickKernel, "-DCANOPY_LIGHT_SAMPLER=" +
+                                                                       std::to_string(data.kind));
   const cl::Context& ctx = rt.context();
   DeviceScene d;
   upload_light_sampler(ctx, lights, data, 0, d);
-  cl::Buffer bp = upload_buffer(ctx, P), bn = upload_buffer(ctx, N);
-  cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, sizeof(int) * kPicks);
-  cl::Kernel k(program, "pick_bench");
-  int a = d.set_light_sampler_args(k, 0);
-  k.setArg(a++, bp);
-  k.setArg(a++, bn);
-  const int seed_arg = a++;
-  k.setArg(a++, cl_int(kPicks));
-  k.setArg(a++, out);
-  k.setArg(seed_arg, cl_uint(0));
-  enqueue_1d(rt.queue(), k, kPicks); // warm-up (and PoCL's work-group compile)
+  KernelArgs args;
+  d.set_args(args);
+  args.set("P", upload_buffer(ctx, P));
+  args.set("N", upload_buffer(ctx, N));
+  args.set("count", cl_int(kPicks));
+  args.set("out", cl::Buffer(ctx, CL_MEM_WRITE_ONLY, sizeof(int) * kPicks));
+  BoundKernel k(program, "pick_bench", args);
+  // Warm-up (and PoCL's work-group compile).
+  enqueue_1d(rt.queue(), k.bind({{"seed", cl_uint(0)}}), kPicks);
   rt.queue().finish();
   double cpu = 0;
   long long picks = 0;
   uint32_t round = 0;
   for (auto _ : state) {
-    k.setArg(seed_arg, cl_uint(++round));
+    const cl::Kernel& kernel = k.bind({{"seed", cl_uint(++round)}});
     double t0 = process_cpu_seconds();
-    enqueue_1d(rt.queue(), k, kPicks);
+    enqueue_1d(rt.queue(), kernel, kPicks);
     rt.queue().finish();
     cpu += process_cpu_seconds() - t0;
     picks += kPicks;

@@ -2,6 +2,7 @@
 // procedural mesh (a displaced torus inside a box of random triangles), and against the same
 // traversal code compiled for the host (cl/geometry.h).
 #include "accel/bvh.h"
+#include "cl/kernel_args.h"
 #include "cl/runtime.h"
 #include "geometry.h"
 #include "support/closest_hit_kernel.h"
@@ -162,14 +163,15 @@ TEST_F(IntersectTest, OcclusionMatchesEmbree) {
     s.dir.w = uint_as_float_(uint(i));
     s.contribution = make_float4(1, 1, 1, 0);
   }
-  cl::Buffer b_nodes = buffer(bvh_->nodes), b_idx = buffer(bvh_->prim_index),
-             b_prims = buffer(*prims_), b_items = buffer(items);
-  cl::Kernel k(*program_, "intersect_shadow");
-  k.setArg(0, b_nodes);
-  k.setArg(1, b_idx);
-  k.setArg(2, b_prims);
-  k.setArg(3, b_items);
-  k.setArg(4, cl_int(kRays));
+  cl::Buffer b_items = buffer(items);
+  KernelArgs args;
+  args.set("nodes", buffer(bvh_->nodes));
+  args.set("prim_index", buffer(bvh_->prim_index));
+  args.set("prims", buffer(*prims_));
+  args.set("shadow_items", b_items);
+  args.set("count", cl_int(kRays));
+  BoundKernel shadow(*program_, "intersect_shadow", args);
+  const cl::Kernel& k = shadow.bind();
   enqueue_1d(rt_->queue(), k, size_t(kRays));
   std::vector<ShadowItem> result(items.size());
   rt_->queue().enqueueReadBuffer(b_items, CL_TRUE, 0, result.size() * sizeof(ShadowItem),

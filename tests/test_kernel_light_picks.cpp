@@ -36,7 +36,7 @@ const char* kPickKernel = R"CL(
 #include "kernels/params.h"
 // Picks a light for streams [0, count) at (P, N): hist[light] += 1 (hist[light_count]: nothing
 // picked); the first `keep` streams also return their light and pmf.
-__kernel void pick_lights(LIGHT_SAMPLER_PARAMS, float4 P, float4 N, uint seed, int count, int keep,
+__kernel void pick_lights(LIGHT_SAMPLER_PARAMS float4 P, float4 N, uint seed, int count, int keep,
                           __global int* hist, __global int* ids, __global float* pmfs) {
   int i = get_global_id(0);
   if (i >= count) return;
@@ -79,13 +79,12 @@ Outcome run_case(ClRuntime& rt, const Case& c) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
   LightSamplerData data = make_light_sampler_data(c.lights, c.sampler, 0.0f, 1);
-  cl::Program program(rt.context(), kPickKernel);
-  std::string opts = "-I " + kernel_dir().string() + " -cl-std=CL1.2 -Werror" +
-                     " -DCANOPY_LIGHT_SAMPLER=" + std::to_string(data.kind);
+  cl::Program program;
   try {
-    program.build({rt.device()}, opts.c_str());
-  } catch (const cl::Error&) {
-    ADD_FAILURE() << program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(rt.device());
+    program =
+        rt.build_program_source(kPickKernel, "-DCANOPY_LIGHT_SAMPLER=" + std::to_string(data.kind));
+  } catch (const ClError& e) {
+    ADD_FAILURE() << e.what();
     return {};
   }
   std::printf("  sampler data %.2f s", secs());
@@ -97,18 +96,19 @@ Outcome run_case(ClRuntime& rt, const Case& c) {
   cl::Buffer hist = upload_buffer(ctx, zeros, CL_MEM_READ_WRITE);
   cl::Buffer ids(ctx, CL_MEM_WRITE_ONLY, sizeof(int) * kKeep);
   cl::Buffer pmfs(ctx, CL_MEM_WRITE_ONLY, sizeof(float) * kKeep);
-  cl::Kernel k(program, "pick_lights");
-  int a = d.set_light_sampler_args(k, 0);
-  k.setArg(a++, f4_from3(c.P, 0.0f));
-  k.setArg(a++, f4_from3(c.N, 0.0f));
-  k.setArg(a++, cl_uint(c.seed));
-  k.setArg(a++, cl_int(c.picks));
-  k.setArg(a++, cl_int(kKeep));
-  k.setArg(a++, hist);
-  k.setArg(a++, ids);
-  k.setArg(a++, pmfs);
+  KernelArgs args;
+  d.set_args(args);
+  args.set("P", f4_from3(c.P, 0.0f));
+  args.set("N", f4_from3(c.N, 0.0f));
+  args.set("seed", cl_uint(c.seed));
+  args.set("count", cl_int(c.picks));
+  args.set("keep", cl_int(kKeep));
+  args.set("hist", hist);
+  args.set("ids", ids);
+  args.set("pmfs", pmfs);
+  BoundKernel k(program, "pick_lights", args);
   std::printf(", kernel built %.2f s", secs());
-  enqueue_1d(rt.queue(), k, size_t(c.picks));
+  enqueue_1d(rt.queue(), k.bind(), size_t(c.picks));
   std::vector<int> h(size_t(n) + 1), dev_ids(kKeep);
   std::vector<float> dev_pmfs(kKeep);
   rt.queue().enqueueReadBuffer(hist, CL_TRUE, 0, sizeof(int) * h.size(), h.data());

@@ -9,6 +9,7 @@
 // test_light_tree_* and end to end by test_render_analytic. generate and accumulate have
 // independent references written here.
 #include "accel/bvh.h"
+#include "cl/kernel_args.h"
 #include "cl/runtime.h"
 #include "integrator/light_pick.h"
 #include "integrator/shade_surface.h"
@@ -80,14 +81,18 @@ void expect_close4(float4 a, float4 b, const std::string& what) {
   expect_close(a.w, b.w, what + ".w");
 }
 
-// Host copies of the path state, uploaded identically to the device.
+// Host copies of the path state (every buffer of PATH_STATE_BUFFERS), uploaded identically to
+// the device.
 struct Paths {
-  std::vector<float4> ray_o, ray_d, throughput, radiance, shade_P, shade_N, shade_f;
-  std::vector<uint32_t> rng;
-  std::vector<Hit> hits;
+#define PATH_VECTOR(T, name) std::vector<T> name;
+  PATH_STATE_BUFFERS(PATH_VECTOR)
+#undef PATH_VECTOR
   PathBuffers host() {
-    return PathBuffers{ray_o.data(), ray_d.data(),   throughput.data(), radiance.data(), rng.data(),
-                       hits.data(),  shade_P.data(), shade_N.data(),    shade_f.data()};
+    PathBuffers pb;
+#define PATH_POINTER(T, name) pb.name = name.data();
+    PATH_STATE_BUFFERS(PATH_POINTER)
+#undef PATH_POINTER
+    return pb;
   }
 };
 
@@ -136,32 +141,18 @@ protected:
     return p;
   }
 
-  struct DevicePaths {
-    cl::Buffer ray_o, ray_d, throughput, radiance, rng, hits, shade_P, shade_N, shade_f;
-  };
-  DevicePaths upload(const Paths& p) {
-    return {to_device(rt_, p.ray_o),    to_device(rt_, p.ray_d),   to_device(rt_, p.throughput),
-            to_device(rt_, p.radiance), to_device(rt_, p.rng),     to_device(rt_, p.hits),
-            to_device(rt_, p.shade_P),  to_device(rt_, p.shade_N), to_device(rt_, p.shade_f)};
+  // The paths' buffers go into `args` under their names; the kernels bind them from there.
+  void upload(const Paths& p, KernelArgs& args) {
+#define PATH_UPLOAD(T, name) args.set(#name, to_device(rt_, p.name));
+    PATH_STATE_BUFFERS(PATH_UPLOAD)
+#undef PATH_UPLOAD
   }
-  Paths download(const DevicePaths& d) {
+  Paths download(const KernelArgs& args) {
     Paths p;
-    p.ray_o = from_device<float4>(rt_, d.ray_o, kPaths);
-    p.ray_d = from_device<float4>(rt_, d.ray_d, kPaths);
-    p.throughput = from_device<float4>(rt_, d.throughput, kPaths);
-    p.radiance = from_device<float4>(rt_, d.radiance, kPaths);
-    p.rng = from_device<uint32_t>(rt_, d.rng, kPaths);
-    p.hits = from_device<Hit>(rt_, d.hits, kPaths);
-    p.shade_P = from_device<float4>(rt_, d.shade_P, kPaths);
-    p.shade_N = from_device<float4>(rt_, d.shade_N, kPaths);
-    p.shade_f = from_device<float4>(rt_, d.shade_f, kPaths);
+#define PATH_DOWNLOAD(T, name) p.name = from_device<T>(rt_, args.buffer(#name), kPaths);
+    PATH_STATE_BUFFERS(PATH_DOWNLOAD)
+#undef PATH_DOWNLOAD
     return p;
-  }
-  int set_path_args(cl::Kernel& k, int i, const DevicePaths& d) {
-    for (const cl::Buffer* b : {&d.ray_o, &d.ray_d, &d.throughput, &d.radiance, &d.rng, &d.hits,
-                                &d.shade_P, &d.shade_N, &d.shade_f})
-      k.setArg(i++, *b);
-    return i;
   }
   void upload_scene() {
     dev_ = upload_device_scene(rt_.context(), geometry_, materials_, scene_.lights, sampler_);
@@ -215,22 +206,18 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
   for (int depth : {0, 1, 2}) {
     SCOPED_TRACE("depth " + std::to_string(depth));
     // ---- shade_surface: device
-    DevicePaths d = upload(paths);
-    cl::Buffer b_queue = to_device(rt_, queue),
-               b_counts(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2));
-    cl::Kernel k(program_, "shade_surface");
-    int a = 0;
-    k.setArg(a++, cl_int(depth));
-    k.setArg(a++, cl_int(3));
-    k.setArg(a++, b_queue);
-    k.setArg(a++, cl_int(kPaths));
-    a = set_path_args(k, a, d);
-    a = dev_.set_scene_args(k, a);
-    a = dev_.set_light_sampler_args(k, a);
-    k.setArg(a++, b_counts);
-    enqueue_1d(rt_.queue(), k, kPaths);
+    KernelArgs args;
+    dev_.set_args(args);
+    upload(paths, args);
+    cl::Buffer b_counts(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2));
+    args.set("counts_shade", b_counts);
+    args.set("max_depth", cl_int(3));
+    BoundKernel k(program_, "shade_surface", args);
+    enqueue_1d(rt_.queue(),
+               k.bind({{"depth", depth}, {"queue", to_device(rt_, queue)}, {"count", kPaths}}),
+               kPaths);
     std::vector<int2> dev_counts = from_device<int2>(rt_, b_counts, kPaths);
-    Paths dev = download(d);
+    Paths dev = download(args);
     // ---- host reference on the same inputs
     Paths ref = paths;
     PathBuffers pb = ref.host();
@@ -257,30 +244,23 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     std::vector<SplitItem> items;
     for (int i = 0; i < kPaths; ++i)
       if (ref_counts[size_t(i)].y) items.push_back(light_sampler_root(&ls, queue[size_t(i)]));
-    DevicePaths d2 = upload(ref); // the shaded state as the next stage sees it
+    upload(ref, args); // the shaded state as the next stage sees it
     PathBuffers pb2 = ref.host();
     int passes = 0, shadow_total = 0, split_items = 0;
     while (!items.empty()) {
       ASSERT_LT(passes, 40);
       size_t n = items.size();
-      cl::Buffer b_items = to_device(rt_, items);
       cl::Buffer b_child(rt_.context(), CL_MEM_READ_WRITE, 4 * n * sizeof(SplitItem));
       cl::Buffer b_shadow(rt_.context(), CL_MEM_READ_WRITE, 4 * n * sizeof(ShadowItem));
       cl::Buffer b_pc(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2));
       std::vector<int> zeros(kPaths, 0);
       cl::Buffer b_cut = to_device(rt_, zeros);
-      cl::Kernel kp(program_, "light_pick");
-      a = 0;
-      kp.setArg(a++, b_items);
-      kp.setArg(a++, cl_int(n));
-      a = set_path_args(kp, a, d2);
-      a = dev_.set_scene_args(kp, a);
-      a = dev_.set_light_sampler_args(kp, a);
-      kp.setArg(a++, b_child);
-      kp.setArg(a++, b_shadow);
-      kp.setArg(a++, b_pc);
-      kp.setArg(a++, b_cut);
-      enqueue_1d(rt_.queue(), kp, n);
+      args.set("child_stage", b_child);
+      args.set("shadow_stage", b_shadow);
+      args.set("counts_pick", b_pc);
+      args.set("cut_size", b_cut);
+      BoundKernel kp(program_, "light_pick", args);
+      enqueue_1d(rt_.queue(), kp.bind({{"split_in", to_device(rt_, items)}, {"count", int(n)}}), n);
       std::vector<int2> dc = from_device<int2>(rt_, b_pc, n);
       std::vector<SplitItem> dchild = from_device<SplitItem>(rt_, b_child, 4 * n);
       std::vector<ShadowItem> dshadow = from_device<ShadowItem>(rt_, b_shadow, 4 * n);
@@ -364,23 +344,22 @@ TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
   const int w = 37, h = 23, n = 3000;
   const uint64_t base = 123457; // a wave that starts mid-image, in the second pass
   std::vector<CameraParams> cp = {make_camera_params(cam, w, h)};
-  cl::Buffer b_cam = to_device(rt_, cp);
-  std::vector<cl::Buffer> out;
-  for (size_t bytes : {sizeof(float4), sizeof(float4), sizeof(float4), sizeof(float4),
-                       sizeof(uint32_t), sizeof(int), sizeof(int2)})
-    out.emplace_back(rt_.context(), CL_MEM_READ_WRITE, n * bytes);
-  cl::Kernel k(program_, "generate");
-  int a = 0;
-  k.setArg(a++, b_cam);
-  k.setArg(a++, cl_uint(99));
-  k.setArg(a++, cl_ulong(base));
-  k.setArg(a++, cl_int(n));
-  for (cl::Buffer& b : out)
-    k.setArg(a++, b);
-  enqueue_1d(rt_.queue(), k, n);
-  auto o = from_device<float4>(rt_, out[0], n), d = from_device<float4>(rt_, out[1], n);
-  auto rng = from_device<uint32_t>(rt_, out[4], n);
-  auto queue = from_device<int>(rt_, out[5], n);
+  KernelArgs args;
+  args.set("cam", to_device(rt_, cp));
+  args.set("seed", cl_uint(99));
+  args.set("wave_base", cl_ulong(base));
+  args.set("count", cl_int(n));
+  for (const char* name : {"ray_o", "ray_d", "throughput", "radiance"})
+    args.set(name, cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(float4)));
+  args.set("rng", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(uint32_t)));
+  args.set("ray_queue", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int)));
+  args.set("path_counts", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2)));
+  BoundKernel k(program_, "generate", args);
+  enqueue_1d(rt_.queue(), k.bind(), n);
+  auto o = from_device<float4>(rt_, args.buffer("ray_o"), n);
+  auto d = from_device<float4>(rt_, args.buffer("ray_d"), n);
+  auto rng = from_device<uint32_t>(rt_, args.buffer("rng"), n);
+  auto queue = from_device<int>(rt_, args.buffer("ray_queue"), n);
   // Independent reference: the pixel's jittered point on the image plane, from the camera basis.
   float3 fwd = normalize(cam.look_at - cam.position), right = normalize(cross(fwd, cam.up));
   float3 up = cross(right, fwd);
@@ -429,18 +408,18 @@ void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
   cl::Buffer b_r = to_device(rt_, radiance), b_s = to_device(rt_, sum), b_q = to_device(rt_, sumsq),
              b_n = to_device(rt_, nonfinite), b_c = to_device(rt_, counts),
              b_fc = to_device(rt_, fc);
-  cl::Kernel k(program_, "accumulate");
-  int a = 0;
-  k.setArg(a++, cl_ulong(base));
-  k.setArg(a++, cl_int(wave));
-  k.setArg(a++, cl_int(npix));
-  k.setArg(a++, b_r);
-  k.setArg(a++, b_s);
-  k.setArg(a++, b_q);
-  k.setArg(a++, b_n);
-  k.setArg(a++, b_c);
-  k.setArg(a++, b_fc);
-  enqueue_1d(rt_.queue(), k, size_t(std::min(npix, wave)));
+  KernelArgs args;
+  args.set("wave_base", cl_ulong(base));
+  args.set("wave_size", cl_int(wave));
+  args.set("npix", cl_int(npix));
+  args.set("radiance", b_r);
+  args.set("film_sum", b_s);
+  args.set("film_sumsq", b_q);
+  args.set("nonfinite", b_n);
+  args.set("path_counts", b_c);
+  args.set("film_counts", b_fc);
+  BoundKernel k(program_, "accumulate", args);
+  enqueue_1d(rt_.queue(), k.bind(), size_t(std::min(npix, wave)));
   auto dsum = from_device<double4>(rt_, b_s, npix), dsq = from_device<double4>(rt_, b_q, npix);
   auto dfc = from_device<double2>(rt_, b_fc, npix);
   EXPECT_EQ(from_device<int>(rt_, b_n, 1)[0], 2);
@@ -489,18 +468,19 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
              b_off(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2)),
              b_bs(rt_.context(), CL_MEM_READ_WRITE, size_t(blocks) * sizeof(int2)),
              b_tot(rt_.context(), CL_MEM_READ_WRITE, 2 * sizeof(int));
-  cl::Kernel ks(program_, "scan_blocks"), kb(program_, "scan_block_sums"),
-      kx(program_, "scatter_split");
-  ks.setArg(0, b_c);
-  ks.setArg(1, cl_int(n));
-  ks.setArg(2, cl_int(block));
-  ks.setArg(3, b_off);
-  ks.setArg(4, b_bs);
-  enqueue_1d(rt_.queue(), ks, size_t(blocks));
-  kb.setArg(0, b_bs);
-  kb.setArg(1, cl_int(blocks));
-  kb.setArg(2, b_tot);
-  enqueue_1d(rt_.queue(), kb, 1);
+  KernelArgs args;
+  args.set("counts", b_c);
+  args.set("n", cl_int(n));
+  args.set("count", cl_int(n));
+  args.set("block", cl_int(block));
+  args.set("offsets", b_off);
+  args.set("block_sums", b_bs);
+  args.set("nblocks", cl_int(blocks));
+  args.set("totals", b_tot);
+  BoundKernel ks(program_, "scan_blocks", args), kb(program_, "scan_block_sums", args),
+      kx(program_, "scatter_split", args);
+  enqueue_1d(rt_.queue(), ks.bind(), size_t(blocks));
+  enqueue_1d(rt_.queue(), kb.bind(), 1);
   auto tot = from_device<int>(rt_, b_tot, 2);
   std::vector<SplitItem> ref_split;
   std::vector<ShadowItem> ref_shadow;
@@ -515,17 +495,11 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
   cl::Buffer b_child = to_device(rt_, child), b_shadow = to_device(rt_, shadow),
              b_so(rt_.context(), CL_MEM_READ_WRITE, ref_split.size() * sizeof(SplitItem)),
              b_sh(rt_.context(), CL_MEM_READ_WRITE, ref_shadow.size() * sizeof(ShadowItem));
-  int a = 0;
-  kx.setArg(a++, cl_int(n));
-  kx.setArg(a++, b_c);
-  kx.setArg(a++, b_off);
-  kx.setArg(a++, b_bs);
-  kx.setArg(a++, cl_int(block));
-  kx.setArg(a++, b_child);
-  kx.setArg(a++, b_shadow);
-  kx.setArg(a++, b_so);
-  kx.setArg(a++, b_sh);
-  enqueue_1d(rt_.queue(), kx, size_t(n));
+  args.set("child_stage", b_child);
+  args.set("shadow_stage", b_shadow);
+  args.set("split_out", b_so);
+  args.set("shadow_items", b_sh);
+  enqueue_1d(rt_.queue(), kx.bind(), size_t(n));
   auto so = from_device<SplitItem>(rt_, b_so, ref_split.size());
   auto sh = from_device<ShadowItem>(rt_, b_sh, ref_shadow.size());
   for (size_t i = 0; i < so.size(); ++i)
@@ -538,12 +512,10 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
   std::vector<float4> radiance(size_t(paths), make_float4(0.5f, 0, 0, 0));
   std::vector<int2> pc(size_t(paths), make_int2(0, 0));
   cl::Buffer b_rad = to_device(rt_, radiance), b_pc = to_device(rt_, pc);
-  cl::Kernel ka(program_, "accumulate_shadow");
-  ka.setArg(0, b_sh);
-  ka.setArg(1, cl_int(sh.size()));
-  ka.setArg(2, b_rad);
-  ka.setArg(3, b_pc);
-  enqueue_1d(rt_.queue(), ka, sh.size());
+  args.set("radiance", b_rad);
+  args.set("path_counts", b_pc);
+  BoundKernel ka(program_, "accumulate_shadow", args);
+  enqueue_1d(rt_.queue(), ka.bind({{"count", int(sh.size())}}), sh.size());
   auto drad = from_device<float4>(rt_, b_rad, size_t(paths));
   auto dpc = from_device<int2>(rt_, b_pc, size_t(paths));
   std::vector<float> run_sum(size_t(paths), 0.0f);

@@ -6,28 +6,44 @@
 
 #include "../types.h"
 
+// The path state, one line per buffer: X(element type, name). The name is the PathBuffers field,
+// the kernel parameter (PATH_PARAMS, cl/kernels/params.h) and the host's argument name; the
+// renderer allocates one element per path of a wave for each. Adding a buffer is one line here.
+// clang-format off
+#define PATH_STATE_BUFFERS(X)                                                                      \
+  X(float4, ray_o)      /* xyz: origin, w: tmin */                                                 \
+  X(float4, ray_d)      /* xyz: unit direction */                                                  \
+  X(float4, throughput) /* xyz: path throughput beta */                                            \
+  X(float4, radiance)   /* xyz: radiance gathered so far */                                        \
+  X(uint, rng)          /* PCG state (cl/rng.h) */                                                 \
+  X(Hit, hits)          /* closest hit of the current ray */                                       \
+  /* The last shading point, kept for light picking in this bounce and for MIS at the next hit. */ \
+  /* xyz: position (the ray origin of rays leaving it, offset from the surface, cl/shading.h), */  \
+  /* w: solid-angle pdf of the BSDF direction that left it */                                      \
+  X(float4, shade_P)                                                                               \
+  /* xyz: normal facing the incoming ray, w: light-pick seed (uint bits) */                        \
+  X(float4, shade_N)                                                                               \
+  /* xyz: beta * BSDF value (diffuse: albedo/pi), w: 1 if BSDF sampling continues the path */      \
+  /* (MIS on), 0 at the last vertex (light sampling alone) */                                      \
+  X(float4, shade_f)
+
+// The scene's buffers, likewise: X(element type, name), read-only on the device.
+#define SCENE_BUFFERS(X)                                                                           \
+  X(BvhNode, nodes)                                                                                \
+  X(int, prim_index)                                                                               \
+  X(Primitive, prims)                                                                              \
+  X(Material, materials)
+// clang-format on
+
+#define CANOPY_PATH_FIELD(T, name) GLOBAL T* name;
+#define CANOPY_SCENE_FIELD(T, name) GLOBAL const T* name;
+
 typedef struct PathBuffers {
-  GLOBAL float4* ray_o;      // xyz: origin, w: tmin
-  GLOBAL float4* ray_d;      // xyz: unit direction
-  GLOBAL float4* throughput; // xyz: path throughput beta
-  GLOBAL float4* radiance;   // xyz: radiance gathered so far
-  GLOBAL uint* rng;          // PCG state (cl/rng.h)
-  GLOBAL Hit* hits;          // closest hit of the current ray
-  // The last shading point, kept for light picking in this bounce and for MIS at the next hit.
-  // xyz: position (the ray origin of rays leaving it, offset from the surface, cl/shading.h),
-  // w: solid-angle pdf of the BSDF direction that left it
-  GLOBAL float4* shade_P;
-  GLOBAL float4* shade_N; // xyz: normal facing the incoming ray, w: light-pick seed (uint bits)
-  GLOBAL float4*
-      shade_f; // xyz: beta * BSDF value (diffuse: albedo/pi), w: 1 if BSDF sampling
-               // continues the path (MIS on), 0 at the last vertex (light sampling alone)
+  PATH_STATE_BUFFERS(CANOPY_PATH_FIELD)
 } PathBuffers;
 
 typedef struct SceneBuffers {
-  GLOBAL const BvhNode* nodes;
-  GLOBAL const int* prim_index;
-  GLOBAL const Primitive* prims;
-  GLOBAL const Material* materials;
+  SCENE_BUFFERS(CANOPY_SCENE_FIELD)
 } SceneBuffers;
 
 #endif // CANOPY_INTEGRATOR_PATH_STATE_H

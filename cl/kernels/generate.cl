@@ -7,7 +7,7 @@
 __kernel void generate(__global const CameraParams* cam, uint seed, ulong wave_base, int count,
                        __global float4* ray_o, __global float4* ray_d,
                        __global float4* throughput, __global float4* radiance,
-                       __global uint* rng_state, __global int* ray_queue,
+                       __global uint* rng, __global int* ray_queue,
                        __global int2* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
@@ -25,7 +25,7 @@ __kernel void generate(__global const CameraParams* cam, uint seed, ulong wave_b
   ray_d[i] = (float4)(d, 0.0f);
   throughput[i] = (float4)(1.0f, 1.0f, 1.0f, 0.0f);
   radiance[i] = (float4)(0.0f);
-  rng_state[i] = r.state;
+  rng[i] = r.state;
   ray_queue[i] = i;
   path_counts[i] = (int2)(0, 0); // shadow rays, shading points
 }

@@ -5,25 +5,26 @@
 #include "geometry.h"
 
 __kernel void intersect_shadow(__global const BvhNode* nodes, __global const int* prim_index,
-                               __global const Primitive* prims, __global ShadowItem* items,
+                               __global const Primitive* prims, __global ShadowItem* shadow_items,
                                int count) {
   int i = get_global_id(0);
   if (i >= count) return;
-  ShadowItem s = items[i];
+  ShadowItem s = shadow_items[i];
   Hit h;
   if (bvh_intersect(nodes, prim_index, prims, s.origin.xyz, s.dir.xyz, 0.0f, s.origin.w, 1, &h) >= 0)
-    items[i].contribution = (float4)(0.0f);
+    shadow_items[i].contribution = (float4)(0.0f);
 }
 
-__kernel void accumulate_shadow(__global const ShadowItem* items, int count,
+__kernel void accumulate_shadow(__global const ShadowItem* shadow_items, int count,
                                 __global float4* radiance, __global int2* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
-  int path = as_int(items[i].dir.w);
-  if (i > 0 && as_int(items[i - 1].dir.w) == path) return; // not the first of its run
+  int path = as_int(shadow_items[i].dir.w);
+  if (i > 0 && as_int(shadow_items[i - 1].dir.w) == path) return; // not the first of its run
   float3 sum = (float3)(0.0f);
   int j = i;
-  for (; j < count && as_int(items[j].dir.w) == path; ++j) sum += items[j].contribution.xyz;
+  for (; j < count && as_int(shadow_items[j].dir.w) == path; ++j)
+    sum += shadow_items[j].contribution.xyz;
   radiance[path] += (float4)(sum, 0.0f);
   path_counts[path].x += j - i;
 }

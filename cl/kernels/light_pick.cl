@@ -5,18 +5,18 @@
 #include "integrator/light_pick.h"
 #include "kernels/params.h"
 
-__kernel void light_pick(__global const SplitItem* items, int count, PATH_PARAMS, SCENE_PARAMS,
-                         LIGHT_SAMPLER_PARAMS, __global SplitItem* child_stage,
-                         __global ShadowItem* shadow_stage, __global int2* counts,
+__kernel void light_pick(__global const SplitItem* split_in, int count, PATH_PARAMS SCENE_PARAMS
+                         LIGHT_SAMPLER_PARAMS __global SplitItem* child_stage,
+                         __global ShadowItem* shadow_stage, __global int2* counts_pick,
                          __global int* cut_size) {
   int i = get_global_id(0);
   if (i >= count) return;
   PATH_ASSEMBLE(pb);
   SCENE_ASSEMBLE(sc);
   LIGHT_SAMPLER_ASSEMBLE(ls);
-  SplitItem it = items[i];
+  SplitItem it = split_in[i];
   int4 r = light_pick_item(it, &ls, &sc, &pb, child_stage + 4 * i, shadow_stage + 4 * i);
-  counts[i] = (int2)(r.x, r.y);
+  counts_pick[i] = (int2)(r.x, r.y);
   // Without splitting a path has exactly one item (its root): a plain store. A locked add is a
   // full barrier on x86 (it waits for this item's shadow-item stores to drain); perf put 19% of the
   // stage's samples just after it (the measured gain is within the noise, docs/performance.md).
@@ -26,15 +26,15 @@ __kernel void light_pick(__global const SplitItem* items, int count, PATH_PARAMS
     atomic_add(&cut_size[it.path], r.z);
 }
 
-__kernel void scatter_split(int count, SCAN_PARAMS, __global const SplitItem* child_stage,
+__kernel void scatter_split(int count, SCAN_PARAMS __global const SplitItem* child_stage,
                             __global const ShadowItem* shadow_stage, __global SplitItem* split_out,
-                            __global ShadowItem* shadow_out) {
+                            __global ShadowItem* shadow_items) {
   int i = get_global_id(0);
   if (i >= count) return;
   int2 c = counts[i];
   int2 pos = block_sums[i / block] + offsets[i];
   for (int j = 0; j < c.x; ++j) split_out[pos.x + j] = child_stage[4 * i + j];
-  for (int j = 0; j < c.y; ++j) shadow_out[pos.y + j] = shadow_stage[4 * i + j];
+  for (int j = 0; j < c.y; ++j) shadow_items[pos.y + j] = shadow_stage[4 * i + j];
 }
 
 // Histogram of cut sizes over this bounce's shading points (last bin: that many or more).

@@ -1,6 +1,10 @@
 // Kernel parameter lists shared by several stages, and the code that assembles the structs of
-// pointers the stage functions take (cl/integrator/path_state.h, light_sampler.h). The host sets
-// these arguments in the same order (host/render/kernel_args.h).
+// pointers the stage functions take (cl/integrator/path_state.h, light_sampler.h). The host binds
+// kernel arguments by name (host/cl/kernel_args.h), so these names are also the host's: order
+// does not matter, and a name the host does not provide is an error when the kernel is bound.
+//
+// Each *_PARAMS list ends with a comma and is written before another parameter:
+//   __kernel void f(int count, PATH_PARAMS SCENE_PARAMS __global int2* out)
 #ifndef CANOPY_KERNEL_PARAMS_H
 #define CANOPY_KERNEL_PARAMS_H
 
@@ -11,40 +15,25 @@
 #define CANOPY_LIGHT_SAMPLER SAMPLER_UNIFORM
 #endif
 
-#define PATH_PARAMS                                                                                \
-  __global float4 *ray_o, __global float4 *ray_d, __global float4 *throughput,                     \
-      __global float4 *radiance, __global uint *rng_state, __global Hit *hits,                     \
-      __global float4 *shade_P, __global float4 *shade_N, __global float4 *shade_f
+// The path state and the scene, generated from PATH_STATE_BUFFERS and SCENE_BUFFERS.
+#define CANOPY_PATH_PARAM(T, name) __global T *name,
+#define CANOPY_SCENE_PARAM(T, name) __global const T *name,
+#define CANOPY_PARAM_NAME(T, name) name,
 
-#define PATH_ASSEMBLE(pb)                                                                          \
-  PathBuffers pb;                                                                                  \
-  pb.ray_o = ray_o;                                                                                \
-  pb.ray_d = ray_d;                                                                                \
-  pb.throughput = throughput;                                                                      \
-  pb.radiance = radiance;                                                                          \
-  pb.rng = rng_state;                                                                              \
-  pb.hits = hits;                                                                                  \
-  pb.shade_P = shade_P;                                                                            \
-  pb.shade_N = shade_N;                                                                            \
-  pb.shade_f = shade_f
+#define PATH_PARAMS PATH_STATE_BUFFERS(CANOPY_PATH_PARAM)
+#define SCENE_PARAMS SCENE_BUFFERS(CANOPY_SCENE_PARAM)
 
-#define SCENE_PARAMS                                                                               \
-  __global const BvhNode *bvh_nodes, __global const int *prim_index,                               \
-      __global const Primitive *prims, __global const Material *materials
-
-#define SCENE_ASSEMBLE(sc)                                                                         \
-  SceneBuffers sc;                                                                                 \
-  sc.nodes = bvh_nodes;                                                                            \
-  sc.prim_index = prim_index;                                                                      \
-  sc.prims = prims;                                                                                \
-  sc.materials = materials
+// PATH_ASSEMBLE(pb): a PathBuffers named pb from the PATH_PARAMS (its fields are in the same
+// order); SCENE_ASSEMBLE(sc): a SceneBuffers named sc from the SCENE_PARAMS.
+#define PATH_ASSEMBLE(pb) PathBuffers pb = {PATH_STATE_BUFFERS(CANOPY_PARAM_NAME)}
+#define SCENE_ASSEMBLE(sc) SceneBuffers sc = {SCENE_BUFFERS(CANOPY_PARAM_NAME)}
 
 #define LIGHT_SAMPLER_PARAMS                                                                       \
   int light_count, __global const Light *lights, __global const float *power_pmf,                  \
       __global const float *alias_prob, __global const int *alias_index,                           \
       __global const float4 *lt_nodes, __global const int4 *lt_children,                           \
       __global const int *lt_leaf_lights, __global const uint *lt_trails, float4 lt_root_sphere,   \
-      float4 lt_root_info, float split_threshold, uint max_cut
+      float4 lt_root_info, float split_threshold, uint max_cut,
 
 #define LIGHT_SAMPLER_ASSEMBLE(ls)                                                                 \
   LightSamplerCtx ls;                                                                              \
@@ -64,8 +53,9 @@
   ls.threshold = split_threshold;                                                                  \
   ls.max_cut = max_cut
 
+// An exclusive scan's input (counts) and result (block_sums[i / block] + offsets[i]).
 #define SCAN_PARAMS                                                                                \
   __global const int2 *counts, __global const int2 *offsets, __global const int2 *block_sums,      \
-      int block
+      int block,
 
 #endif // CANOPY_KERNEL_PARAMS_H

@@ -4,19 +4,19 @@
 #include "kernels/params.h"
 
 __kernel void shade_surface(int depth, int max_depth, __global const int* queue, int count,
-                            PATH_PARAMS, SCENE_PARAMS, LIGHT_SAMPLER_PARAMS,
-                            __global int2* counts) {
+                            PATH_PARAMS SCENE_PARAMS LIGHT_SAMPLER_PARAMS
+                            __global int2* counts_shade) {
   int i = get_global_id(0);
   if (i >= count) return;
   PATH_ASSEMBLE(pb);
   SCENE_ASSEMBLE(sc);
   LIGHT_SAMPLER_ASSEMBLE(ls);
-  counts[i] = shade_surface_item(queue[i], depth, max_depth, &sc, &pb, &ls);
+  counts_shade[i] = shade_surface_item(queue[i], depth, max_depth, &sc, &pb, &ls);
 }
 
-__kernel void scatter_shade(__global const int* queue, int count, SCAN_PARAMS,
+__kernel void scatter_shade(__global const int* queue, int count, SCAN_PARAMS
                             __global int* queue_out, __global SplitItem* split_out,
-                            float4 root_sphere, float root_cv2, uint max_cut,
+                            float4 lt_root_sphere, float4 lt_root_info, uint max_cut,
                             __global int2* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
@@ -27,11 +27,11 @@ __kernel void scatter_shade(__global const int* queue, int count, SCAN_PARAMS,
   if (c.y) {
     path_counts[path].y += 1; // one shading point per path and bounce: no race
     SplitItem it;
-    it.sphere = root_sphere;
+    it.sphere = lt_root_sphere;
     it.path = path;
     it.code = 0;
     it.budget = max_cut;
-    it.cv2 = root_cv2;
+    it.cv2 = lt_root_info.x; // the root's cv^2
     split_out[pos.y] = it;
   }
 }

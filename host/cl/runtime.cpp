@@ -208,12 +208,18 @@ cl::Program ClRuntime::build_program(const std::vector<std::string>& files,
   std::string source;
   for (const auto& f : files)
     source += read_text(dir / f) + "\n";
+  return build_program_source(source, options);
+}
+
+cl::Program ClRuntime::build_program_source(const std::string& source,
+                                            const std::string& options) const {
+  std::filesystem::path dir = kernel_dir();
   cl::Program program(context_, source);
   // PoCL passes the option string to clang verbatim: no quotes, so escape spaces instead.
   std::string inc;
   for (char c : dir.string())
     inc += c == ' ' ? std::string("\\ ") : std::string(1, c);
-  std::string opts = fmt::format("-I {} -cl-std=CL1.2 {}", inc, options);
+  std::string opts = fmt::format("-I {} -cl-std=CL1.2 -cl-kernel-arg-info {}", inc, options);
   // The tests build kernels with -Werror (a warning in a kernel is a defect like one in the host
   // code); users' builds stay tolerant of whatever a newer PoCL clang may warn about.
   if (const char* w = std::getenv("CANOPY_KERNEL_WERROR"); w && *w && std::string(w) != "0")

@@ -47,10 +47,14 @@ public:
   // Otherwise the first device whose device or platform name contains it (case-insensitive).
   explicit ClRuntime(const std::string& device_name = "");
 
-  // Builds a program from the given files (relative to kernel_dir()) with "-I <kernel_dir>" and
-  // `options` appended. Throws ClError holding the build log on failure.
+  // Builds a program from the given files (relative to kernel_dir()) with "-I <kernel_dir>",
+  // "-cl-kernel-arg-info" (kernel arguments are bound by name, host/cl/kernel_args.h) and `options`
+  // appended. Throws ClError holding the build log on failure.
   cl::Program build_program(const std::vector<std::string>& files,
                             const std::string& options = "") const;
+  // The same for source text (test and benchmark kernels that include headers from cl/).
+  cl::Program build_program_source(const std::string& source,
+                                   const std::string& options = "") const;
 
   const cl::Context& context() const { return context_; }
   const cl::Device& device() const { return device_; }

@@ -60,34 +60,23 @@ void upload_light_sampler(const cl::Context& ctx, const std::vector<Light>& ligh
   d.max_cut = sampler.root_budget();
 }
 
-int DeviceScene::set_bvh_args(cl::Kernel& k, int i) const {
-  k.setArg(i++, nodes);
-  k.setArg(i++, prim_index);
-  k.setArg(i++, prims);
-  return i;
-}
-
-int DeviceScene::set_scene_args(cl::Kernel& k, int i) const {
-  i = set_bvh_args(k, i);
-  k.setArg(i++, materials);
-  return i;
-}
-
-int DeviceScene::set_light_sampler_args(cl::Kernel& k, int i) const {
-  k.setArg(i++, cl_int(light_count));
-  k.setArg(i++, lights);
-  k.setArg(i++, power_pmf);
-  k.setArg(i++, alias_prob);
-  k.setArg(i++, alias_index);
-  k.setArg(i++, lt_nodes);
-  k.setArg(i++, lt_children);
-  k.setArg(i++, lt_leaf_lights);
-  k.setArg(i++, lt_trails);
-  k.setArg(i++, root_sphere);
-  k.setArg(i++, root_info);
-  k.setArg(i++, cl_float(split_threshold));
-  k.setArg(i++, cl_uint(max_cut));
-  return i;
+void DeviceScene::set_args(KernelArgs& args) const {
+#define CANOPY_SET_SCENE_ARG(T, name) args.set(#name, name);
+  SCENE_BUFFERS(CANOPY_SET_SCENE_ARG)
+#undef CANOPY_SET_SCENE_ARG
+  args.set("light_count", cl_int(light_count));
+  args.set("lights", lights);
+  args.set("power_pmf", power_pmf);
+  args.set("alias_prob", alias_prob);
+  args.set("alias_index", alias_index);
+  args.set("lt_nodes", lt_nodes);
+  args.set("lt_children", lt_children);
+  args.set("lt_leaf_lights", lt_leaf_lights);
+  args.set("lt_trails", lt_trails);
+  args.set("lt_root_sphere", root_sphere);
+  args.set("lt_root_info", root_info);
+  args.set("split_threshold", cl_float(split_threshold));
+  args.set("max_cut", cl_uint(max_cut));
 }
 
 } // namespace canopy

@@ -1,9 +1,11 @@
-// The scene's device buffers and the one place that binds them to kernel arguments in the order of
-// cl/kernels/params.h (SCENE_PARAMS, LIGHT_SAMPLER_PARAMS). Used by the renderer and by the kernel
-// tests, so the argument order lives in one place.
+// The scene's device buffers and the one place that names them as kernel arguments (the names of
+// cl/kernels/params.h: SCENE_PARAMS, LIGHT_SAMPLER_PARAMS). Used by the renderer, the kernel tests
+// and the benchmarks.
 #pragma once
 
 #include "accel/bvh.h"
+#include "cl/kernel_args.h"
+#include "integrator/path_state.h"
 #include "render/light_sampler_data.h"
 
 #include <CL/opencl.hpp>
@@ -23,17 +25,20 @@ cl::Buffer upload_buffer(const cl::Context& ctx, const std::vector<T>& v,
 }
 
 struct DeviceScene {
-  cl::Buffer nodes, prim_index, prims, materials, lights;
+#define CANOPY_DEVICE_SCENE_BUFFER(T, name) cl::Buffer name;
+  SCENE_BUFFERS(CANOPY_DEVICE_SCENE_BUFFER) // nodes, prim_index, prims, materials
+#undef CANOPY_DEVICE_SCENE_BUFFER
+  cl::Buffer lights;
   cl::Buffer power_pmf, alias_prob, alias_index, lt_nodes, lt_children, lt_leaf_lights, lt_trails;
   int light_count = 0;
   float4 root_sphere{0, 0, 0, 0}, root_info{0, 0, 0, 0};
   float split_threshold = 0.0f;
   uint32_t max_cut = 1;
 
-  // BVH arguments of the intersect kernels (nodes, prim_index, prims).
-  int set_bvh_args(cl::Kernel& k, int index) const;
-  int set_scene_args(cl::Kernel& k, int index) const;         // SCENE_PARAMS
-  int set_light_sampler_args(cl::Kernel& k, int index) const; // LIGHT_SAMPLER_PARAMS
+  // Names every buffer and scalar above as the kernels' arguments (SCENE_PARAMS,
+  // LIGHT_SAMPLER_PARAMS). Buffers not uploaded (e.g. no geometry) stay without a value, so a
+  // kernel that takes one fails to bind.
+  void set_args(KernelArgs& args) const;
 };
 
 // `emission_exponent` k: the device copy of every light's emission is multiplied by 2^-k (exact for

@@ -174,35 +174,45 @@ Film Renderer::render(const RenderSettings& settings) {
                 {"image", uint64_t(npix) * 3 * sizeof(float)}},
                printable(scene_.path.string(), 1024));
 
-  // Path state (struct of arrays) and queues, sized for one wave.
-  cl::Buffer ray_o = device_buffer(ctx, W * sizeof(float4));
-  cl::Buffer ray_d = device_buffer(ctx, W * sizeof(float4));
-  cl::Buffer throughput = device_buffer(ctx, W * sizeof(float4));
-  cl::Buffer radiance = device_buffer(ctx, W * sizeof(float4));
-  cl::Buffer rng = device_buffer(ctx, W * sizeof(cl_uint));
-  cl::Buffer hits = device_buffer(ctx, W * sizeof(Hit));
-  cl::Buffer shade_P = device_buffer(ctx, W * sizeof(float4));
-  cl::Buffer shade_N = device_buffer(ctx, W * sizeof(float4));
-  cl::Buffer shade_f = device_buffer(ctx, W * sizeof(float4));
-  cl::Buffer queue_a = device_buffer(ctx, W * sizeof(cl_int));
+  // Every kernel argument by name (host/cl/kernel_args.h); the names are the kernels' parameter
+  // names. Values that change from launch to launch (count, queue, depth, ...) are given to each
+  // launch and never stored here, so a launch cannot pick up a stale one.
+  KernelArgs args;
+  auto buffer = [&](const char* name, size_t bytes) {
+    cl::Buffer b = device_buffer(ctx, bytes);
+    args.set(name, b);
+    return b;
+  };
+  device_.set_args(args);
+  args.set("cam", camera_);
+  args.set("seed", cl_uint(settings.seed));
+  args.set("max_depth", cl_int(max_depth));
+  args.set("npix", cl_int(npix));
+  args.set("block", cl_int(kScanBlock));
+  args.set("bins", cl_int(kCutBins));
+  // Path state (struct of arrays, cl/integrator/path_state.h) and queues, sized for one wave.
+#define CANOPY_PATH_BUFFER(T, name) buffer(#name, W * sizeof(T));
+  PATH_STATE_BUFFERS(CANOPY_PATH_BUFFER)
+#undef CANOPY_PATH_BUFFER
+  cl::Buffer queue_a = buffer("ray_queue", W * sizeof(cl_int)); // generate's output
   cl::Buffer queue_b = device_buffer(ctx, W * sizeof(cl_int));
-  cl::Buffer counts_shade = device_buffer(ctx, W * sizeof(cl_int2));
-  cl::Buffer cut_size = device_buffer(ctx, W * sizeof(cl_int));
+  cl::Buffer counts_shade = buffer("counts_shade", W * sizeof(cl_int2));
+  cl::Buffer cut_size = buffer("cut_size", W * sizeof(cl_int));
   cl::Buffer split_a = device_buffer(ctx, split_cap * sizeof(SplitItem));
   cl::Buffer split_b = device_buffer(ctx, split_cap * sizeof(SplitItem));
-  cl::Buffer child_stage = device_buffer(ctx, 4 * split_cap * sizeof(SplitItem));
-  cl::Buffer shadow_stage = device_buffer(ctx, 4 * split_cap * sizeof(ShadowItem));
-  cl::Buffer shadow = device_buffer(ctx, split_cap * sizeof(ShadowItem));
-  cl::Buffer counts = device_buffer(ctx, split_cap * sizeof(cl_int2));
-  cl::Buffer offsets = device_buffer(ctx, split_cap * sizeof(cl_int2));
-  cl::Buffer block_sums = device_buffer(ctx, (split_cap / kScanBlock + 2) * sizeof(cl_int2));
-  cl::Buffer totals = device_buffer(ctx, 2 * sizeof(cl_int));
-  cl::Buffer histogram = device_buffer(ctx, kCutBins * sizeof(cl_int));
-  cl::Buffer nonfinite = device_buffer(ctx, sizeof(cl_int));
-  cl::Buffer film_sum = device_buffer(ctx, size_t(npix) * sizeof(double4));
-  cl::Buffer film_sumsq = device_buffer(ctx, size_t(npix) * sizeof(double4));
-  cl::Buffer film_counts = device_buffer(ctx, size_t(npix) * sizeof(double2));
-  cl::Buffer path_counts = device_buffer(ctx, W * sizeof(cl_int2));
+  buffer("child_stage", 4 * split_cap * sizeof(SplitItem));
+  buffer("shadow_stage", 4 * split_cap * sizeof(ShadowItem));
+  buffer("shadow_items", split_cap * sizeof(ShadowItem));
+  cl::Buffer counts_pick = buffer("counts_pick", split_cap * sizeof(cl_int2));
+  buffer("offsets", split_cap * sizeof(cl_int2));
+  buffer("block_sums", (split_cap / kScanBlock + 2) * sizeof(cl_int2));
+  cl::Buffer totals = buffer("totals", 2 * sizeof(cl_int));
+  cl::Buffer histogram = buffer("histogram", kCutBins * sizeof(cl_int));
+  cl::Buffer nonfinite = buffer("nonfinite", sizeof(cl_int));
+  cl::Buffer film_sum = buffer("film_sum", size_t(npix) * sizeof(double4));
+  cl::Buffer film_sumsq = buffer("film_sumsq", size_t(npix) * sizeof(double4));
+  cl::Buffer film_counts = buffer("film_counts", size_t(npix) * sizeof(double2));
+  buffer("path_counts", W * sizeof(cl_int2));
   q.enqueueFillBuffer(film_sum, cl_double(0), 0, size_t(npix) * sizeof(double4));
   q.enqueueFillBuffer(film_sumsq, cl_double(0), 0, size_t(npix) * sizeof(double4));
   q.enqueueFillBuffer(film_counts, cl_double(0), 0, size_t(npix) * sizeof(double2));
@@ -216,110 +226,59 @@ Film Renderer::render(const RenderSettings& settings) {
   reset_counters();
   std::vector<cl_int> hist(kCutBins);
 
-  cl::Kernel k_generate(program_, "generate");
-  cl::Kernel k_closest(program_, "intersect_closest");
-  cl::Kernel k_shade(program_, "shade_surface");
-  cl::Kernel k_scatter_shade(program_, "scatter_shade");
-  cl::Kernel k_pick(program_, "light_pick");
-  cl::Kernel k_scatter_split(program_, "scatter_split");
-  cl::Kernel k_histogram(program_, "cut_histogram");
-  cl::Kernel k_shadow(program_, "intersect_shadow");
-  cl::Kernel k_shadow_sum(program_, "accumulate_shadow");
-  cl::Kernel k_accumulate(program_, "accumulate");
-  cl::Kernel k_scan_blocks(program_, "scan_blocks");
-  cl::Kernel k_scan_sums(program_, "scan_block_sums");
+  BoundKernel k_generate(program_, "generate", args);
+  BoundKernel k_closest(program_, "intersect_closest", args);
+  BoundKernel k_shade(program_, "shade_surface", args);
+  BoundKernel k_scatter_shade(program_, "scatter_shade", args);
+  BoundKernel k_pick(program_, "light_pick", args);
+  BoundKernel k_scatter_split(program_, "scatter_split", args);
+  BoundKernel k_histogram(program_, "cut_histogram", args);
+  BoundKernel k_shadow(program_, "intersect_shadow", args);
+  BoundKernel k_shadow_sum(program_, "accumulate_shadow", args);
+  BoundKernel k_accumulate(program_, "accumulate", args);
+  BoundKernel k_scan_blocks(program_, "scan_blocks", args);
+  BoundKernel k_scan_sums(program_, "scan_block_sums", args);
 
   std::vector<std::pair<const char*, cl::Event>> events;
-  auto run = [&](const char* stage, cl::Kernel& k, size_t n) {
+  // Arguments are bound (and checked) even when there is no work.
+  auto run = [&](const char* stage, const cl::Kernel& k, size_t n) {
     if (n == 0) return;
     events.emplace_back(stage, enqueue_1d(q, k, n));
     StageStats& s = stats_.stages[stage];
     s.items += n;
     s.launches += 1;
   };
-  auto path_args = [&](cl::Kernel& k, int i) {
-    for (cl::Buffer* b :
-         {&ray_o, &ray_d, &throughput, &radiance, &rng, &hits, &shade_P, &shade_N, &shade_f})
-      k.setArg(i++, *b);
-    return i;
-  };
   // Exclusive scan of the count pairs in `c` (n items); returns the two totals.
   auto scan = [&](const cl::Buffer& c, int n) {
     int blocks = (n + kScanBlock - 1) / kScanBlock;
-    k_scan_blocks.setArg(0, c);
-    k_scan_blocks.setArg(1, cl_int(n));
-    k_scan_blocks.setArg(2, cl_int(kScanBlock));
-    k_scan_blocks.setArg(3, offsets);
-    k_scan_blocks.setArg(4, block_sums);
-    run("scan", k_scan_blocks, size_t(blocks));
-    k_scan_sums.setArg(0, block_sums);
-    k_scan_sums.setArg(1, cl_int(blocks));
-    k_scan_sums.setArg(2, totals);
-    run("scan", k_scan_sums, 1);
+    run("scan", k_scan_blocks.bind({{"counts", c}, {"n", n}}), size_t(blocks));
+    run("scan", k_scan_sums.bind({{"nblocks", blocks}}), 1);
     cl_int t[2];
     q.enqueueReadBuffer(totals, CL_TRUE, 0, sizeof(t), t);
     return std::pair<int, int>(t[0], t[1]);
   };
-  auto scan_args = [&](cl::Kernel& k, int i, const cl::Buffer& c) {
-    k.setArg(i++, c);
-    k.setArg(i++, offsets);
-    k.setArg(i++, block_sums);
-    k.setArg(i++, cl_int(kScanBlock));
-    return i;
-  };
 
   for (uint64_t base = 0; base < total; base += W) {
     const int count0 = int(std::min<uint64_t>(W, total - base));
-    int a = 0;
-    k_generate.setArg(a++, camera_);
-    k_generate.setArg(a++, cl_uint(settings.seed));
-    k_generate.setArg(a++, cl_ulong(base));
-    k_generate.setArg(a++, cl_int(count0));
-    k_generate.setArg(a++, ray_o);
-    k_generate.setArg(a++, ray_d);
-    k_generate.setArg(a++, throughput);
-    k_generate.setArg(a++, radiance);
-    k_generate.setArg(a++, rng);
-    k_generate.setArg(a++, queue_a);
-    k_generate.setArg(a++, path_counts);
-    run("generate", k_generate, size_t(count0));
+    run("generate", k_generate.bind({{"wave_base", cl_ulong(base)}, {"count", count0}}),
+        size_t(count0));
 
     cl::Buffer* q_in = &queue_a;
     cl::Buffer* q_out = &queue_b;
     int count = count0;
     for (int depth = 0; depth < max_depth && count > 0; ++depth) {
-      a = 0;
-      a = device_.set_bvh_args(k_closest, a);
-      k_closest.setArg(a++, *q_in);
-      k_closest.setArg(a++, cl_int(count));
-      k_closest.setArg(a++, ray_o);
-      k_closest.setArg(a++, ray_d);
-      k_closest.setArg(a++, hits);
-      run("intersect_closest", k_closest, size_t(count));
-
-      a = 0;
-      k_shade.setArg(a++, cl_int(depth));
-      k_shade.setArg(a++, cl_int(max_depth));
-      k_shade.setArg(a++, *q_in);
-      k_shade.setArg(a++, cl_int(count));
-      a = path_args(k_shade, a);
-      a = device_.set_scene_args(k_shade, a);
-      a = device_.set_light_sampler_args(k_shade, a);
-      k_shade.setArg(a++, counts_shade);
-      run("shade_surface", k_shade, size_t(count));
+      run("intersect_closest", k_closest.bind({{"queue", *q_in}, {"count", count}}), size_t(count));
+      run("shade_surface", k_shade.bind({{"depth", depth}, {"queue", *q_in}, {"count", count}}),
+          size_t(count));
 
       auto [next_count, shade_count] = scan(counts_shade, count);
-      a = 0;
-      k_scatter_shade.setArg(a++, *q_in);
-      k_scatter_shade.setArg(a++, cl_int(count));
-      a = scan_args(k_scatter_shade, a, counts_shade);
-      k_scatter_shade.setArg(a++, *q_out);
-      k_scatter_shade.setArg(a++, split_a);
-      k_scatter_shade.setArg(a++, sampler_.tree.root_sphere);
-      k_scatter_shade.setArg(a++, cl_float(sampler_.tree.root_info.x));
-      k_scatter_shade.setArg(a++, cl_uint(sampler_.root_budget()));
-      k_scatter_shade.setArg(a++, path_counts);
-      run("scatter", k_scatter_shade, size_t(count));
+      run("scatter",
+          k_scatter_shade.bind({{"queue", *q_in},
+                                {"count", count},
+                                {"counts", counts_shade},
+                                {"queue_out", *q_out},
+                                {"split_out", split_a}}),
+          size_t(count));
       stats_.shading_points += uint64_t(shade_count);
       q.enqueueFillBuffer(cut_size, cl_int(0), 0, W * sizeof(cl_int));
 
@@ -328,65 +287,25 @@ Film Renderer::render(const RenderSettings& settings) {
       cl::Buffer* s_out = &split_b;
       int n = shade_count;
       while (n > 0) {
-        a = 0;
-        k_pick.setArg(a++, *s_in);
-        k_pick.setArg(a++, cl_int(n));
-        a = path_args(k_pick, a);
-        a = device_.set_scene_args(k_pick, a);
-        a = device_.set_light_sampler_args(k_pick, a);
-        k_pick.setArg(a++, child_stage);
-        k_pick.setArg(a++, shadow_stage);
-        k_pick.setArg(a++, counts);
-        k_pick.setArg(a++, cut_size);
-        run("light_pick", k_pick, size_t(n));
-        auto [n_children, n_shadow] = scan(counts, n);
-        a = 0;
-        k_scatter_split.setArg(a++, cl_int(n));
-        a = scan_args(k_scatter_split, a, counts);
-        k_scatter_split.setArg(a++, child_stage);
-        k_scatter_split.setArg(a++, shadow_stage);
-        k_scatter_split.setArg(a++, *s_out);
-        k_scatter_split.setArg(a++, shadow);
-        run("scatter", k_scatter_split, size_t(n));
-
-        a = 0;
-        a = device_.set_bvh_args(k_shadow, a);
-        k_shadow.setArg(a++, shadow);
-        k_shadow.setArg(a++, cl_int(n_shadow));
-        run("intersect_shadow", k_shadow, size_t(n_shadow));
-        k_shadow_sum.setArg(0, shadow);
-        k_shadow_sum.setArg(1, cl_int(n_shadow));
-        k_shadow_sum.setArg(2, radiance);
-        k_shadow_sum.setArg(3, path_counts);
-        run("accumulate_shadow", k_shadow_sum, size_t(n_shadow));
+        run("light_pick", k_pick.bind({{"split_in", *s_in}, {"count", n}}), size_t(n));
+        auto [n_children, n_shadow] = scan(counts_pick, n);
+        run("scatter",
+            k_scatter_split.bind({{"count", n}, {"counts", counts_pick}, {"split_out", *s_out}}),
+            size_t(n));
+        run("intersect_shadow", k_shadow.bind({{"count", n_shadow}}), size_t(n_shadow));
+        run("accumulate_shadow", k_shadow_sum.bind({{"count", n_shadow}}), size_t(n_shadow));
         stats_.shadow_rays += uint64_t(n_shadow);
         std::swap(s_in, s_out);
         n = n_children;
       }
-      a = 0;
-      k_histogram.setArg(a++, *q_in);
-      k_histogram.setArg(a++, cl_int(count));
-      k_histogram.setArg(a++, counts_shade);
-      k_histogram.setArg(a++, cut_size);
-      k_histogram.setArg(a++, histogram);
-      k_histogram.setArg(a++, cl_int(kCutBins));
-      run("cut_histogram", k_histogram, size_t(count));
+      run("cut_histogram", k_histogram.bind({{"queue", *q_in}, {"count", count}}), size_t(count));
 
       std::swap(q_in, q_out);
       count = next_count;
     }
 
-    a = 0;
-    k_accumulate.setArg(a++, cl_ulong(base));
-    k_accumulate.setArg(a++, cl_int(count0));
-    k_accumulate.setArg(a++, cl_int(npix));
-    k_accumulate.setArg(a++, radiance);
-    k_accumulate.setArg(a++, film_sum);
-    k_accumulate.setArg(a++, film_sumsq);
-    k_accumulate.setArg(a++, nonfinite);
-    k_accumulate.setArg(a++, path_counts);
-    k_accumulate.setArg(a++, film_counts);
-    run("accumulate", k_accumulate, size_t(std::min(count0, npix)));
+    run("accumulate", k_accumulate.bind({{"wave_base", cl_ulong(base)}, {"wave_size", count0}}),
+        size_t(std::min(count0, npix)));
     q.finish();
     for (auto& [stage, ev] : events)
       stats_.stages[stage].seconds += event_seconds(ev);
