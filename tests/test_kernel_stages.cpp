@@ -82,12 +82,14 @@ void expect_close4(float4 a, float4 b, const std::string& what) {
 
 // Host copies of the path state, uploaded identically to the device.
 struct Paths {
-  std::vector<float4> ray_o, ray_d, throughput, radiance, shade_P, shade_N, shade_f;
+  std::vector<float4> ray_o, ray_d, throughput, radiance, shade_P, shade_N, shade_f, shade_wo,
+      shade_Ns;
   std::vector<uint32_t> rng;
   std::vector<Hit> hits;
   PathBuffers host() {
-    return PathBuffers{ray_o.data(), ray_d.data(),   throughput.data(), radiance.data(), rng.data(),
-                       hits.data(),  shade_P.data(), shade_N.data(),    shade_f.data()};
+    return PathBuffers{ray_o.data(),   ray_d.data(),    throughput.data(), radiance.data(),
+                       rng.data(),     hits.data(),     shade_P.data(),    shade_N.data(),
+                       shade_f.data(), shade_wo.data(), shade_Ns.data()};
   }
 };
 
@@ -132,17 +134,21 @@ protected:
                                       i % 3 == 0 ? 0.0f : u(rng)));
       p.shade_N.push_back(f4_from3(normalize(make_float3(u(rng) - 0.5f, 1.0f, u(rng) - 0.5f)), 0));
       p.shade_f.push_back(make_float4(0, 0, 0, 0));
+      p.shade_wo.push_back(make_float4(0, 0, 0, 0));
+      p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
     }
     return p;
   }
 
   struct DevicePaths {
-    cl::Buffer ray_o, ray_d, throughput, radiance, rng, hits, shade_P, shade_N, shade_f;
+    cl::Buffer ray_o, ray_d, throughput, radiance, rng, hits, shade_P, shade_N, shade_f, shade_wo,
+        shade_Ns;
   };
   DevicePaths upload(const Paths& p) {
     return {to_device(rt_, p.ray_o),    to_device(rt_, p.ray_d),   to_device(rt_, p.throughput),
             to_device(rt_, p.radiance), to_device(rt_, p.rng),     to_device(rt_, p.hits),
-            to_device(rt_, p.shade_P),  to_device(rt_, p.shade_N), to_device(rt_, p.shade_f)};
+            to_device(rt_, p.shade_P),  to_device(rt_, p.shade_N), to_device(rt_, p.shade_f),
+            to_device(rt_, p.shade_wo), to_device(rt_, p.shade_Ns)};
   }
   Paths download(const DevicePaths& d) {
     Paths p;
@@ -155,11 +161,13 @@ protected:
     p.shade_P = from_device<float4>(rt_, d.shade_P, kPaths);
     p.shade_N = from_device<float4>(rt_, d.shade_N, kPaths);
     p.shade_f = from_device<float4>(rt_, d.shade_f, kPaths);
+    p.shade_wo = from_device<float4>(rt_, d.shade_wo, kPaths);
+    p.shade_Ns = from_device<float4>(rt_, d.shade_Ns, kPaths);
     return p;
   }
   int set_path_args(cl::Kernel& k, int i, const DevicePaths& d) {
     for (const cl::Buffer* b : {&d.ray_o, &d.ray_d, &d.throughput, &d.radiance, &d.rng, &d.hits,
-                                &d.shade_P, &d.shade_N, &d.shade_f})
+                                &d.shade_P, &d.shade_N, &d.shade_f, &d.shade_wo, &d.shade_Ns})
       k.setArg(i++, *b);
     return i;
   }
@@ -193,6 +201,8 @@ void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& w
     expect_close(dev.shade_N[p].x, ref.shade_N[p].x, at + " N");
     EXPECT_EQ(float_as_uint_(dev.shade_N[p].w), float_as_uint_(ref.shade_N[p].w)) << at << " seed";
     expect_close4(dev.shade_f[p], ref.shade_f[p], at + " shade_f");
+    expect_close4(dev.shade_wo[p], ref.shade_wo[p], at + " shade_wo");
+    expect_close4(dev.shade_Ns[p], ref.shade_Ns[p], at + " shade_Ns");
     if (::testing::Test::HasFailure()) return; // one path's report is enough
   }
 }

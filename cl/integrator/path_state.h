@@ -17,10 +17,12 @@ typedef struct PathBuffers {
   // xyz: position (the ray origin of rays leaving it, offset from the surface, cl/shading.h),
   // w: solid-angle pdf of the BSDF direction that left it
   GLOBAL float4* shade_P;
-  GLOBAL float4* shade_N; // xyz: normal facing the incoming ray, w: light-pick seed (uint bits)
-  GLOBAL float4*
-      shade_f; // xyz: beta * BSDF value (diffuse: albedo/pi), w: 1 if BSDF sampling
-               // continues the path (MIS on), 0 at the last vertex (light sampling alone)
+  GLOBAL float4* shade_N; // xyz: geometric normal facing wo, w: light-pick seed (uint bits)
+  // xyz: path throughput beta at the shading point, w: 1 if light samples are MIS-weighted
+  // against BSDF sampling (the path continues with a BSDF sample and MIS is on), else 0
+  GLOBAL float4* shade_f;
+  GLOBAL float4* shade_wo; // xyz: unit direction towards the viewer, w: material index (int bits)
+  GLOBAL float4* shade_Ns; // xyz: shading normal (on wo's side; the geometric one when flat)
 } PathBuffers;
 
 typedef struct SceneBuffers {

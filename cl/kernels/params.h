@@ -14,7 +14,8 @@
 #define PATH_PARAMS                                                                                \
   __global float4 *ray_o, __global float4 *ray_d, __global float4 *throughput,                     \
       __global float4 *radiance, __global uint *rng_state, __global Hit *hits,                     \
-      __global float4 *shade_P, __global float4 *shade_N, __global float4 *shade_f
+      __global float4 *shade_P, __global float4 *shade_N, __global float4 *shade_f,                \
+      __global float4 *shade_wo, __global float4 *shade_Ns
 
 #define PATH_ASSEMBLE(pb)                                                                          \
   PathBuffers pb;                                                                                  \
@@ -26,7 +27,9 @@
   pb.hits = hits;                                                                                  \
   pb.shade_P = shade_P;                                                                            \
   pb.shade_N = shade_N;                                                                            \
-  pb.shade_f = shade_f
+  pb.shade_f = shade_f;                                                                            \
+  pb.shade_wo = shade_wo;                                                                          \
+  pb.shade_Ns = shade_Ns
 
 #define SCENE_PARAMS                                                                               \
   __global const BvhNode *bvh_nodes, __global const int *prim_index,                               \

@@ -143,6 +143,7 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   t0 = Clock::now();
   KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_.kind)
                                                  : scene_features(scene, sampler_.kind);
+  features.mis = options.mis;
   stats_.kernel_options = features.build_options();
   program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
@@ -184,6 +185,8 @@ Film Renderer::render(const RenderSettings& settings) {
   cl::Buffer shade_P = device_buffer(ctx, W * sizeof(float4));
   cl::Buffer shade_N = device_buffer(ctx, W * sizeof(float4));
   cl::Buffer shade_f = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer shade_wo = device_buffer(ctx, W * sizeof(float4));
+  cl::Buffer shade_Ns = device_buffer(ctx, W * sizeof(float4));
   cl::Buffer queue_a = device_buffer(ctx, W * sizeof(cl_int));
   cl::Buffer queue_b = device_buffer(ctx, W * sizeof(cl_int));
   cl::Buffer counts_shade = device_buffer(ctx, W * sizeof(cl_int2));
@@ -238,8 +241,8 @@ Film Renderer::render(const RenderSettings& settings) {
     s.launches += 1;
   };
   auto path_args = [&](cl::Kernel& k, int i) {
-    for (cl::Buffer* b :
-         {&ray_o, &ray_d, &throughput, &radiance, &rng, &hits, &shade_P, &shade_N, &shade_f})
+    for (cl::Buffer* b : {&ray_o, &ray_d, &throughput, &radiance, &rng, &hits, &shade_P, &shade_N,
+                          &shade_f, &shade_wo, &shade_Ns})
       k.setArg(i++, *b);
     return i;
   };
