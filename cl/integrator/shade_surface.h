@@ -70,7 +70,9 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   pb->rng[path] = r.state;
 
   int continues = depth + 1 < max_depth;
-  out.y = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && bsdf_has_smooth_lobe(&m);
+  // Light shapes are black diffuse: nothing to pick lights for.
+  int black = m.type == MATERIAL_DIFFUSE && !(max3(xyz_of(m.albedo)) > 0.0f);
+  out.y = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && bsdf_has_smooth_lobe(&m) && !black;
   pb->shade_N[path] = f4_from3(N, uint_as_float_(light_seed));
   pb->shade_f[path] = f4_from3(beta, continues && CANOPY_MIS ? 1.0f : 0.0f);
   pb->shade_wo[path] = f4_from3(wo, uint_as_float_((uint)prim->material));
