@@ -44,6 +44,7 @@ constexpr int kChi2Tests = 256; // an upper bound on the chi-square tests in thi
 constexpr double kSignificance = 0.01 / kChi2Tests;
 constexpr int kSamples = 100000;
 constexpr double kFloatEps = 5.9604645e-8; // 2^-24
+constexpr double kQuadratureTol = 1e-4;    // absolute error of a pdf integral over the sphere
 
 const float kRoughness[] = {0.001f, 0.01f, 0.1f, 0.3f, 1.0f};
 const float kAnglesDeg[] = {0.0f, 30.0f, 60.0f, 80.0f, 89.9f};
@@ -285,7 +286,10 @@ struct Chi2Result {
 };
 // Categories with expected count < 5 are pooled into one (pbrt-v4, Mitsuba); observations where
 // the expected count is 0 make the test fail.
-Chi2Result chi2_test(const std::vector<double>& observed, const std::vector<double>& expected) {
+// `pool_floor` is the smallest expected count the pool may have: the absorbed share is known only
+// as 1 - (integral of the pdf), to the quadrature's accuracy.
+Chi2Result chi2_test(const std::vector<double>& observed, const std::vector<double>& expected,
+                     double pool_floor) {
   Chi2Result r;
   double pool_o = 0, pool_e = 0, worst = -1;
   int cats = 0;
@@ -304,6 +308,7 @@ Chi2Result chi2_test(const std::vector<double>& observed, const std::vector<doub
                 " expected " + std::to_string(expected[i]);
     }
   }
+  pool_e = std::max(pool_e, pool_floor);
   if (pool_e > 0) {
     double d = pool_o - pool_e, c = d * d / pool_e;
     r.chi2 += c;
@@ -443,7 +448,7 @@ BinnedCase run_binned(const Material& m, float3 wo, const HGrid& g, const PdfFn&
   // What the delta lobe and the pdf leave is absorbed.
   expected[kBins] = std::max(0.0, 1 - p_delta - integral) * kSamples;
   expected[kBins + 1] = p_delta * kSamples;
-  Chi2Result r = chi2_test(observed, expected);
+  Chi2Result r = chi2_test(observed, expected, kQuadratureTol * kSamples);
   c.chi2_p = r.p;
   c.integral = integral;
   c.absorbed = observed[kBins] / kSamples;
@@ -492,7 +497,7 @@ void test_glossy_grid(const NamedMaterial& nm, uint32_t seed, Summary* sum) {
       // The pdf integrates to 1 minus the absorbed share: binomial noise of the absorbed count
       // (5 sigma) plus the quadrature tolerance.
       double sigma = std::sqrt(std::max(c.absorbed * (1 - c.absorbed), 1.0 / kSamples) / kSamples);
-      EXPECT_NEAR(c.integral + c.absorbed, 1.0, 5 * sigma + 1e-4)
+      EXPECT_NEAR(c.integral + c.absorbed, 1.0, 5 * sigma + kQuadratureTol)
           << "integral " << c.integral << " absorbed " << c.absorbed;
       if (m.type == MATERIAL_PLASTIC) {
         HGrid wide{1.0};
@@ -750,15 +755,14 @@ TEST(Bsdf, WhiteFurnaceConductor) {
         EXPECT_NEAR(quad, ref, 1e-4) << "integral of bsdf_eval " << quad << " reference " << ref;
       }
       // The known masking loss: ~0 for a smooth surface seen from above, tens of percent for
-      // alpha = 1 (Kulla & Conty 2017, Fig. 3), and most of it at grazing angles.
+      // alpha = 1 (Kulla & Conty 2017, "Revisiting Physically Based Shading at Imageworks").
       if (alpha <= 1e-4f && deg <= 60) {
         EXPECT_GT(ref, 0.99);
       }
-      if (alpha == 1.0f) {
+      // (At the horizon itself the loss vanishes again: G2 / G1(wo) -> 1 as Lambda(wo) -> inf,
+      // so the albedo tends to the share of visible-normal reflections that leave upwards.)
+      if (alpha == 1.0f && deg <= 80) {
         EXPECT_LT(ref, 0.9);
-      }
-      if (alpha == 1.0f && deg >= 80) {
-        EXPECT_LT(ref, 0.7);
       }
       std::printf("white furnace roughness %g theta_o %g: albedo %.6f (sampled %.6f +- %.1e)\n", r,
                   deg, ref, mean, sigma);
