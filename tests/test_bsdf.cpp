@@ -40,7 +40,7 @@
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kChi2Tests = 256; // an upper bound on the chi-square tests in this file
+constexpr int kChi2Tests = 320; // an upper bound on the chi-square tests in this file
 constexpr double kSignificance = 0.01 / kChi2Tests;
 constexpr int kSamples = 100000;
 constexpr double kFloatEps = 5.9604645e-8; // 2^-24
@@ -330,15 +330,30 @@ Chi2Result chi2_test(const std::vector<double>& observed, const std::vector<doub
 constexpr int kRings = 16, kAzimuths = 24;
 constexpr int kBins = 1 + (kRings - 1) * kAzimuths;
 
+// a_bin > 0: the half-vector grid above. a_bin == 0: the plain grid of pbrt-v4's test over the
+// reflected directions themselves, kWCos bins in cos(theta_i) over [0, 1] (the lower hemisphere
+// holds no non-absorbed sample) by kWPhi bins in phi_i, used where the lobe is broad enough for a
+// fixed quadrature (roughness >= 0.3, diffuse): it checks the sampler against the pdf without the
+// half-vector mapping.
+constexpr int kWCos = 10, kWPhi = 20;
+static_assert(kWCos * kWPhi <= kBins);
+
 struct HGrid {
   double a_bin;
+  bool wi_space() const { return a_bin == 0; }
   // ring r spans u in [r, r + 1) / kRings; theta edge of u: tan^2 = a^2 u / (1 - u)
   double theta_edge(int r) const {
     if (r >= kRings) return 0.5 * kPi;
     double u = double(r) / kRings;
     return std::atan(a_bin * std::sqrt(u / (1 - u)));
   }
-  int bin_of(D3 h) const {
+  int bin_of(D3 wi, D3 h) const {
+    if (wi_space()) {
+      int c = std::min(kWCos - 1, int(std::max(0.0, wi.z) * kWCos));
+      double phi = std::atan2(wi.y, wi.x);
+      if (phi < 0) phi += 2 * kPi;
+      return c * kWPhi + std::min(kWPhi - 1, int(phi / (2 * kPi) * kWPhi));
+    }
     double r2 = h.x * h.x + h.y * h.y;
     double u = r2 / (r2 + h.z * h.z * a_bin * a_bin);
     int ring = std::min(kRings - 1, int(u * kRings));
@@ -375,6 +390,50 @@ std::vector<double> bin_probabilities(const HGrid& g, float3 wo_f, const PdfFn& 
                                       double lobe_scale) {
   D3 wo = d3(wo_f);
   std::vector<double> prob(kBins, 0.0);
+  if (g.wi_space()) {
+    // Panels: quarters of each bin, plus breakpoints closing in on the mirror direction's
+    // coordinates (where a lobe peaks) when it lies in the bin, and on the horizon.
+    double c_r = wo.z, phi_r = std::atan2(-wo.y, -wo.x);
+    if (phi_r < 0) phi_r += 2 * kPi;
+    auto breaks = [](double a, double b, double peak) {
+      std::vector<double> x = {a, b};
+      for (int i = 1; i < 4; ++i)
+        x.push_back(a + (b - a) * i / 4);
+      if (a == 0) // towards the horizon, where a grazing lobe is squeezed
+        for (double d = b / 8; d > b * 1e-5; d *= 0.5)
+          x.push_back(d);
+      if (peak > a && peak < b)
+        for (double d = (b - a) / 8; d > (b - a) * 1e-5; d *= 0.5) {
+          x.push_back(peak);
+          if (peak - d > a) x.push_back(peak - d);
+          if (peak + d < b) x.push_back(peak + d);
+        }
+      std::sort(x.begin(), x.end());
+      x.erase(std::unique(x.begin(), x.end()), x.end());
+      return x;
+    };
+    for (int c = 0; c < kWCos; ++c)
+      for (int a = 0; a < kWPhi; ++a) {
+        std::vector<double> cs = breaks(double(c) / kWCos, double(c + 1) / kWCos, c_r);
+        std::vector<double> ps = breaks(2 * kPi * a / kWPhi, 2 * kPi * (a + 1) / kWPhi, phi_r);
+        double sum = 0;
+        for (size_t i = 0; i + 1 < cs.size(); ++i)
+          sum += gauss12(
+              [&](double z) {
+                double sz = std::sqrt(std::max(0.0, 1 - z * z)), t = 0;
+                for (size_t j = 0; j + 1 < ps.size(); ++j)
+                  t += gauss12(
+                      [&](double phi) {
+                        return pdf(wo_f, {sz * std::cos(phi), sz * std::sin(phi), z});
+                      },
+                      ps[j], ps[j + 1]);
+                return t;
+              },
+              cs[i], cs[i + 1]);
+        prob[c * kWPhi + a] = sum;
+      }
+    return prob;
+  }
   auto density = [&](double theta, double phi) {
     D3 h = h_at(theta, phi);
     double woh = ddot(wo, h);
@@ -434,7 +493,7 @@ std::vector<BinnedCase> run_binned(const Material& m, float3 wo, const std::vect
            close(w.y, s.weight.y, 1e-4f) && close(w.z, s.weight.z, 1e-4f);
       D3 h = dnormalize({double(wo.x) + s.wi.x, double(wo.y) + s.wi.y, double(wo.z) + s.wi.z});
       for (size_t g = 0; g < grids.size(); ++g)
-        observed[g][grids[g].bin_of(h)] += 1;
+        observed[g][grids[g].bin_of(d3(s.wi), h)] += 1;
     }
     if (!ok && ++bad <= 3)
       ADD_FAILURE() << "sample " << i << ": wi (" << s.wi.x << ", " << s.wi.y << ", " << s.wi.z
@@ -506,6 +565,7 @@ void test_glossy_grid(const NamedMaterial& nm, uint32_t seed, Summary* sum) {
       // Plastic: also at a_bin = 1, the diffuse lobe's scale (the same samples).
       std::vector<HGrid> grids = {g};
       if (m.type == MATERIAL_PLASTIC) grids.push_back(HGrid{1.0});
+      if (r >= 0.3f) grids.push_back(HGrid{0.0});
       std::vector<BinnedCase> cs = run_binned(m, wo, grids, pdf, 0.0, seed++);
       const BinnedCase& c = cs[0];
       sum->add(name, c.chi2_p);
@@ -514,7 +574,8 @@ void test_glossy_grid(const NamedMaterial& nm, uint32_t seed, Summary* sum) {
       double sigma = std::sqrt(std::max(c.absorbed * (1 - c.absorbed), 1.0 / kSamples) / kSamples);
       EXPECT_NEAR(c.integral + c.absorbed, 1.0, 5 * sigma + kQuadratureTol)
           << "integral " << c.integral << " absorbed " << c.absorbed;
-      if (cs.size() > 1) sum->add(name + " (a_bin 1)", cs[1].chi2_p);
+      for (size_t k = 1; k < cs.size(); ++k)
+        sum->add(name + (grids[k].wi_space() ? " (wi grid)" : " (a_bin 1)"), cs[k].chi2_p);
     }
   }
 }
@@ -528,8 +589,11 @@ TEST(Bsdf, DiffuseSamplesFollowPdf) {
   for (float deg : kAnglesDeg) {
     float3 wo = wo_at(deg);
     SCOPED_TRACE("theta_o " + std::to_string(deg));
-    BinnedCase c = run_binned(m, wo, {HGrid{1.0}}, float_pdf(&m), 0.0, seed++)[0];
+    std::vector<BinnedCase> cs =
+        run_binned(m, wo, {HGrid{1.0}, HGrid{0.0}}, float_pdf(&m), 0.0, seed++);
+    const BinnedCase& c = cs[0];
     sum.add("diffuse theta_o " + std::to_string(deg), c.chi2_p);
+    sum.add("diffuse theta_o " + std::to_string(deg) + " (wi grid)", cs[1].chi2_p);
     EXPECT_EQ(c.absorbed, 0.0);
     EXPECT_NEAR(c.integral, 1.0, 1e-4);
   }
