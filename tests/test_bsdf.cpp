@@ -21,9 +21,11 @@
 // directions nor the float pdf resolve the lobe's shape, so the bins are a_bin = 64 eps / cos and
 // the expected counts come from an independent double-precision pdf (ref_* below): the test
 // then checks that the sampler puts the right mass inside the lobe's cap and the right tail outside
-// it, and the float pdf is checked against the reference where it is resolvable. Plastic is binned
-// twice, at the coat's scale and at a_bin = 1 (the diffuse lobe's scale). Each chi-square test
-// passes when its p-value is above 0.01 / kChi2Tests (Bonferroni over all of them).
+// it, and the float pdf is checked against the reference where it is resolvable. The same samples
+// are also binned at a_bin = 1 for plastic (the diffuse lobe's scale) and, for broad lobes
+// (roughness >= 0.3, diffuse), on pbrt-v4's plain (cos theta_i, phi_i) grid, which needs no
+// half-vector mapping. Each chi-square test passes when its p-value is above 0.01 / kChi2Tests
+// (Bonferroni over all of them). 10^5 samples per case.
 #include "bsdf/bsdf.h"
 
 #include <gtest/gtest.h>
