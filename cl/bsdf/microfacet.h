@@ -3,8 +3,8 @@
 // callers treat alpha == 0 as a delta lobe and never call these. Compiled only for scenes with a
 // glossy material (HAS_MICROFACET), so a diffuse-only kernel holds no GGX code.
 //
-// Every formula is arranged to stay finite for alpha down to ~1e-19 and for directions at the
-// horizon: no 1 - x cancellations, no tan, no division by a cosine that may be 0.
+// Every formula is arranged to stay finite for any alpha ggx_alpha gives (>= 1e-7) and for
+// directions at the horizon: no 1 - x cancellations, no tan, no division by a cosine that may be 0.
 #ifndef CANOPY_CL_BSDF_MICROFACET_H
 #define CANOPY_CL_BSDF_MICROFACET_H
 
@@ -28,7 +28,7 @@ INLINE float ggx_alpha(float alpha) {
 // D(h) = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2) (Walter et al. 2007, eq. 33). For unit h the
 // bracket is (h.x^2 + h.y^2) + h.z^2 alpha^2; dividing it by alpha^2 gives
 // s = (h.x^2 + h.y^2) / alpha^2 + h.z^2 and D = 1 / (pi alpha^2 s^2). The naive form rounds
-// the bracket to 0 near h = n for alpha < ~3e-4 in float; this one is exact there (s = 1).
+// the bracket to 0 near h = n for alpha < ~2.4e-4 in float; this one is exact there (s = 1).
 INLINE float ggx_D(float3 h, float alpha) {
   float a2 = alpha * alpha;
   float s = (h.x * h.x + h.y * h.y) / a2 + h.z * h.z;
