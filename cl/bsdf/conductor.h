@@ -25,7 +25,7 @@ INLINE float3 conductor_eval(const Material* m, float3 wo, float3 wi) {
   float3 h = half_vector(wo, wi, &ok);
   if (!ok) return zero;
   float alpha = ggx_alpha(m->alpha);
-  return conductor_fresnel(m, dot(wo, h)) * ggx_reflection(wo, wi, h, alpha);
+  return conductor_fresnel(m, half_cos(wo, wi, h)) * ggx_reflection(wo, wi, h, alpha);
 }
 
 INLINE float conductor_pdf(const Material* m, float3 wo, float3 wi) {
@@ -62,7 +62,7 @@ INLINE BsdfSample conductor_sample(const Material* m, float3 wo, float3 u) {
   float lo = ggx_lambda_len(wo, alpha), li = ggx_lambda_len(wi, alpha);
   float den = wi.z * lo + wo.z * li;
   float g = den > 0.0f ? wi.z * (wo.z + lo) / den : 0.0f;
-  s.weight = conductor_fresnel(m, dot(wo, h)) * g;
+  s.weight = conductor_fresnel(m, half_cos(wo, wi, h)) * g;
   return s;
 }
 

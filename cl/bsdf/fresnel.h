@@ -15,9 +15,11 @@
 INLINE float fresnel_dielectric(float cos_i, float eta) {
   cos_i = clamp(cos_i, 0.0f, 1.0f);
   if (!(eta > 0.0f)) return 1.0f;
-  float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta); // Snell: sin_t = sin_i / eta
-  if (sin2_t >= 1.0f) return 1.0f;
-  float cos_t = sqrt(1.0f - sin2_t);
+  // Snell: cos_t^2 = 1 - (1 - cos_i^2) / eta^2 = ((eta^2 - 1) + cos_i^2) / eta^2, summed in this
+  // order so eta near 1 keeps cos_t exact at grazing angles (no 1 - (1 - x) cancellation).
+  float cos2_t_eta2 = (eta * eta - 1.0f) + cos_i * cos_i;
+  if (cos2_t_eta2 <= 0.0f) return 1.0f; // total internal reflection
+  float cos_t = sqrt(cos2_t_eta2) / eta;
   float ds = cos_i + eta * cos_t, dp = eta * cos_i + cos_t;
   if (!(ds > 0.0f) || !(dp > 0.0f)) return 1.0f; // cos_i = cos_t = 0: grazing, full reflection
   float rs = (cos_i - eta * cos_t) / ds;
@@ -38,7 +40,7 @@ INLINE float fresnel_conductor1(float c, float eta, float k) {
   float c2 = c * c;
   float s = fmax(0.0f, 1.0f - c2);
   float eta2 = eta * eta, k2 = k * k;
-  float t0 = eta2 - k2 - s;
+  float t0 = (eta2 - k2 - 1.0f) + c2; // eta^2 - k^2 - s, without rounding s = 1 - c^2 first
   float ab2 = sqrt(t0 * t0 + 4.0f * eta2 * k2);
   float a = sqrt(fmax(0.0f, 0.5f * (ab2 + t0)));
   float num_s = ab2 - 2.0f * a * c + c2, den_s = ab2 + 2.0f * a * c + c2;

@@ -3,8 +3,8 @@
 // callers treat alpha == 0 as a delta lobe and never call these. Compiled only for scenes with a
 // glossy material (HAS_MICROFACET), so a diffuse-only kernel holds no GGX code.
 //
-// Every formula is arranged to stay finite for alpha down to ~1e-19 and for directions at the
-// horizon: no 1 - x cancellations, no tan, no division by a cosine that may be 0.
+// Every formula is arranged to stay finite for any alpha ggx_alpha gives (>= 1e-7) and for
+// directions at the horizon: no 1 - x cancellations, no tan, no division by a cosine that may be 0.
 #ifndef CANOPY_CL_BSDF_MICROFACET_H
 #define CANOPY_CL_BSDF_MICROFACET_H
 
@@ -28,7 +28,7 @@ INLINE float ggx_alpha(float alpha) {
 // D(h) = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2) (Walter et al. 2007, eq. 33). For unit h the
 // bracket is (h.x^2 + h.y^2) + h.z^2 alpha^2; dividing it by alpha^2 gives
 // s = (h.x^2 + h.y^2) / alpha^2 + h.z^2 and D = 1 / (pi alpha^2 s^2). The naive form rounds
-// the bracket to 0 near h = n for alpha < ~3e-4 in float; this one is exact there (s = 1).
+// the bracket to 0 near h = n for alpha < ~2.4e-4 in float; this one is exact there (s = 1).
 INLINE float ggx_D(float3 h, float alpha) {
   float a2 = alpha * alpha;
   float s = (h.x * h.x + h.y * h.y) / a2 + h.z * h.z;
@@ -86,18 +86,27 @@ INLINE float ggx_reflection_pdf(float3 wo, float3 wi, float3 h, float alpha) {
 // A visible normal for wo (wo.z > 0), from u1, u2 in [0, 1): the spherical-cap form of Dupuy &
 // Benyoub 2023 ("Sampling Visible GGX Normals with Spherical Caps", Listing 3). In the
 // configuration stretched to alpha = 1 the visible normals are wo_s + c with c uniform on the
-// cap z > -wo_s.z of the unit sphere. 1 - z and 1 + z of the cap point are computed directly
-// (u2 (1 + wz) and (1 - u2)(1 + wz)) so sin theta has no cancellation near the poles.
+// cap z > -wo_s.z of the unit sphere, z = 1 - t with t = u2 (1 + wo_s.z) uniform. sin theta
+// comes from t (2 - t) = 1 - z^2 and the normal's z from (1 + wo_s.z)(1 - u2) = z + wo_s.z,
+// without cancellation near the poles.
 INLINE float3 ggx_sample_visible_normal(float3 wo, float alpha, float u1, float u2) {
   float3 ws = normalize(make_float3(alpha * wo.x, alpha * wo.y, wo.z));
   float one_plus_wz = 1.0f + ws.z;
-  float sin_t = one_plus_wz * sqrt(fmax(0.0f, u2 * (1.0f - u2)));
+  float t = u2 * one_plus_wz;
+  float sin_t = sqrt(fmax(0.0f, t * (2.0f - t)));
   float phi = 2.0f * CANOPY_PI * u1;
   float3 hs =
       make_float3(sin_t * cos(phi) + ws.x, sin_t * sin(phi) + ws.y, one_plus_wz * (1.0f - u2));
   float3 h = make_float3(alpha * hs.x, alpha * hs.y, hs.z); // unstretch
   float l2 = dot(h, h);
   return l2 > 0.0f ? h * (1.0f / sqrt(l2)) : make_float3(0.0f, 0.0f, 1.0f);
+}
+
+// The cosine between each direction of a reflection pair and its half vector (wo.h == wi.h in
+// exact arithmetic), as a symmetric expression so that a Fresnel factor of it keeps
+// f(wo, wi) == f(wi, wo) exact in float.
+INLINE float half_cos(float3 wo, float3 wi, float3 h) {
+  return 0.5f * (dot(wo, h) + dot(wi, h));
 }
 
 INLINE float3 reflect_about(float3 wo, float3 h) {

@@ -38,8 +38,8 @@ INLINE float3 plastic_eval(const Material* m, float3 wo, float3 wi) {
   int ok;
   float3 h = half_vector(wo, wi, &ok);
   if (!ok) return f;
-  float coat =
-      fresnel_dielectric(dot(wo, h), m->ior) * ggx_reflection(wo, wi, h, ggx_alpha(m->alpha));
+  float coat = fresnel_dielectric(half_cos(wo, wi, h), m->ior) *
+               ggx_reflection(wo, wi, h, ggx_alpha(m->alpha));
   return f + xyz_of(m->specular) * coat;
 }
 
