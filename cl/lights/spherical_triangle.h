@@ -1,0 +1,94 @@
+// Uniform sampling of the solid angle of a spherical triangle (Arvo 1995, "Stratified Sampling of
+// Spherical Triangles", SIGGRAPH, Fig. 2), and its solid angle to float relative precision (Van
+// Oosterom & Strackee 1983). Vertices are given as vectors from the viewpoint (not unit) together
+// with the triangle's edge vectors and |a . (b x c)|, which callers compute from the light's own
+// edges and plane distance: differences of nearly equal unit vectors would lose the precision a
+// small or nearby triangle needs.
+#ifndef CANOPY_CL_LIGHTS_SPHERICAL_TRIANGLE_H
+#define CANOPY_CL_LIGHTS_SPHERICAL_TRIANGLE_H
+
+#include "../compat.h"
+
+typedef struct SphTri {
+  float3 A, B, C;  // unit directions towards the vertices
+  float3 t_ac;     // unit tangent of the arc A -> C at A
+  float cos_alpha; // angle at vertex A (between the arcs A->B and A->C)
+  float sin_alpha;
+  float alpha;
+  float cos_c; // A . B (c: the arc opposite C)
+  float area;  // alpha + beta + gamma - pi: the range of Arvo's first variable
+  float omega; // solid angle for the pdf (see sph_tri_setup)
+} SphTri;
+
+// a, b, c: vertices relative to the viewpoint; ab = b - a, ac = c - a, bc = c - b computed from
+// the light's edges; abs_t = |a . (b x c)| (= plane distance * twice the triangle's area).
+INLINE SphTri sph_tri_setup(float3 a, float3 b, float3 c, float3 ab, float3 ac, float3 bc,
+                            float abs_t) {
+  SphTri t;
+  float la = length(a), lb = length(b), lc = length(c);
+  t.A = a / la;
+  t.B = b / lb;
+  t.C = c / lc;
+  // Normals of the great circles through the edges, from the accurate edge vectors:
+  // a x b = a x (b - a) etc. The angle at a vertex is the angle between the two normals there;
+  // |(a x b) x (a x c)| = |a . (b x c)| |a|, so each angle is an atan2 of accurate terms.
+  float3 n_ab = cross(a, ab);
+  float3 n_ac = cross(a, ac);
+  float3 n_bc = cross(b, bc);
+  float ca = dot(n_ab, n_ac), sa = abs_t * la;
+  float cb = -dot(n_ab, n_bc), sb = abs_t * lb;
+  float cc = dot(n_ac, n_bc), sc = abs_t * lc;
+  t.alpha = atan2(sa, ca);
+  float beta = atan2(sb, cb);
+  float gamma = atan2(sc, cc);
+  float ra = sqrt(sa * sa + ca * ca);
+  t.cos_alpha = ra > 0.0f ? ca / ra : 1.0f;
+  t.sin_alpha = ra > 0.0f ? sa / ra : 0.0f;
+  t.cos_c = dot(t.A, t.B);
+  float3 tac = ac - t.A * dot(ac, t.A);
+  float ltac = length(tac);
+  t.t_ac = ltac > 0.0f ? tac / ltac : make_float3(0.0f, 0.0f, 0.0f);
+  t.area = fmax(0.0f, t.alpha + beta + gamma - CANOPY_PI);
+  // The angle sum loses ~1e-6 sr absolute to cancellation against pi, too much for the pdf of a
+  // small triangle; Van Oosterom & Strackee's tan(omega/2) = |a.(b x c)| / (|a||b||c| + (a.b)|c|
+  // + (a.c)|b| + (b.c)|a|) keeps relative precision there. It is ill-conditioned only near
+  // omega = pi with a tiny numerator (a viewpoint almost on the plane above an edge), where the
+  // angle sum is accurate: each is used where it is good.
+  if (!(abs_t > 0.0f)) {
+    t.omega = 0.0f;
+  } else if (t.area >= 0.5f) {
+    t.omega = t.area;
+  } else {
+    float den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+    t.omega = 2.0f * atan2(abs_t, den);
+  }
+  return t;
+}
+
+// Unit direction uniformly distributed in the triangle's solid angle for (u1, u2) in [0,1)^2.
+// First a point C' on the arc A -> C such that the triangle A B C' has area u1 * area, then a
+// point on the arc B -> C' uniform in 1 - cos of its distance to B.
+INLINE float3 sph_tri_sample(const SphTri* t, float u1, float u2) {
+  float ah = u1 * t->area;
+  float sp = sin(ah - t->alpha), cp = cos(ah - t->alpha);
+  float uu = cp - t->cos_alpha;
+  float vv = sp + t->sin_alpha * t->cos_c;
+  float num = (vv * cp - uu * sp) * t->cos_alpha - vv;
+  float den = (vv * sp + uu * cp) * t->sin_alpha;
+  float q = num / den;          // cos of the arc A -> C'
+  if (!(q >= -1.0f)) q = -1.0f; // also a 0/0 of a degenerate triangle
+  if (!(q <= 1.0f)) q = 1.0f;
+  float3 c1 = t->A * q + t->t_ac * sqrt(fmax(0.0f, 1.0f - q * q));
+  // 1 - C'.B as |C' - B|^2 / 2, and the tangent at B from C' - B: both keep their precision when
+  // C' is close to B.
+  float3 dcb = c1 - t->B;
+  float k = fmin(2.0f, 0.5f * dot(dcb, dcb));
+  float omz = u2 * k; // 1 - cos of the distance to B
+  float sz = sqrt(fmax(0.0f, omz * (2.0f - omz)));
+  float3 tb = dcb - t->B * dot(dcb, t->B);
+  float ltb = length(tb);
+  if (!(ltb > 0.0f)) return t->B;
+  return normalize(t->B * (1.0f - omz) + tb * (sz / ltb));
+}
+
+#endif // CANOPY_CL_LIGHTS_SPHERICAL_TRIANGLE_H
