@@ -10,10 +10,16 @@
 //   uniform in solid angle, pdf = 1 / omega. The apex makes a viewpoint almost on the plane well
 //   conditioned: every arc from F then starts near the nadir, where a whole triangle seen from
 //   1e-6 above would otherwise be a spherical triangle with all three vertices on the horizon.
-// - Area sampling when omega < LIGHT_SOLID_ANGLE_MIN: the float mapping of both spherical methods
-//   works with angles near pi or 2 pi, so its resolution is ~1e-7 rad absolute and its distortion
-//   ~1e-7 / omega relative; below 1e-3 sr the light spans less than ~2 degrees, where the area
-//   pdf varies little over the light and area sampling is as good.
+// - Both samplers take their range from a solid angle accurate to float relative precision (Van
+//   Oosterom & Strackee's formula where the angle sum, which loses ~1e-6 sr to cancellation, is
+//   small) and map it with formulas that keep that precision (spherical_*.h): perturbing every
+//   sin, cos and atan2 by 2 ulps moves the sampled directions by ~1e-6 of the light's angular
+//   size on average, ~1e-4 at worst, for solid angles down to 1e-5 sr.
+// - Area sampling when omega < LIGHT_SOLID_ANGLE_MIN = 1e-3 sr: the light then spans less than ~2
+//   degrees, the area pdf d^2 / (cos A) varies by a fraction of a percent over it unless it is
+//   seen edge-on (when its contribution is small), and area sampling costs one square root
+//   instead of a dozen trigonometric functions. Also when omega is not finite, or P is on the
+//   plane (pdf 0 either way).
 #ifndef CANOPY_CL_LIGHTS_PLANAR_SOLID_ANGLE_H
 #define CANOPY_CL_LIGHTS_PLANAR_SOLID_ANGLE_H
 

@@ -13,9 +13,10 @@ typedef struct SphRect {
   float x0, y0, x1, y1, z0;
   float b0, b1;       // z components of the normals of the planes through the edges y0, y1
   float b0sq_minus_1; // b0^2 - 1 without cancellation
-  float k;            // 2 pi - g2 - g3 (paper: the offset of the first variable)
-  float area;         // g0 + g1 + g2 + g3 - 2 pi: the range of the first variable
-  float omega;        // solid angle for the pdf (see sph_rect_setup)
+  float cos_k, sin_k; // k = 2 pi - g2 - g3, the paper's offset of the first variable
+  float n0;           // cos(k) b0 - b1
+  float area;         // g0 + g1 + g2 + g3 - 2 pi (accurate only when large)
+  float omega;        // solid angle: the pdf and the range of the first variable
 } SphRect;
 
 // d: corner - viewpoint; ex, ey: unit edge directions (orthogonal); ez: unit normal; lx, ly: edge
@@ -48,8 +49,16 @@ INLINE SphRect sph_rect_setup(float3 d, float3 ex, float3 ey, float3 ez, float l
   r.b0 = -r.y0 / sqrt(z2 + r.y0 * r.y0);
   r.b1 = r.y1 / sqrt(z2 + r.y1 * r.y1);
   r.b0sq_minus_1 = -z2 / (z2 + r.y0 * r.y0);
-  r.k = 2.0f * CANOPY_PI - g2 - g3;
-  r.area = fmax(0.0f, g0 + g1 - r.k);
+  r.area = fmax(0.0f, g0 + g1 + g2 + g3 - 2.0f * CANOPY_PI);
+  // cos and sin of k = (pi - g2) + (pi - g3) from the atan2 arguments of g2 and g3, not from k:
+  // the first variable is k + u omega, and k rounded to float would move it by ~1e-7 absolute,
+  // a distortion of ~1e-7 / omega of the sampled x.
+  float s2 = h * l01, c2 = r.x0 * r.y1, s3 = h * l00, c3 = -r.x0 * r.y0;
+  float r2 = sqrt(s2 * s2 + c2 * c2), r3 = sqrt(s3 * s3 + c3 * c3);
+  float cg2 = c2 / r2, sg2 = s2 / r2, cg3 = c3 / r3, sg3 = s3 / r3;
+  r.cos_k = cg2 * cg3 - sg2 * sg3;
+  r.sin_k = -(sg2 * cg3 + cg2 * sg3);
+  r.n0 = r.cos_k * r.b0 - r.b1;
   // The angle sum loses ~1e-6 sr absolute to cancellation against 2 pi: for a small rectangle the
   // pdf takes the solid angle of its two halves by Van Oosterom & Strackee's formula instead
   // (cl/lights/spherical_triangle.h), whose triple product is h * lx * ly for either half.
@@ -72,8 +81,15 @@ INLINE SphRect sph_rect_setup(float3 d, float3 ex, float3 ey, float3 ez, float l
 // angle, for (u, v) in [0,1)^2 (the point is (xu, yv, z0) in the local frame).
 INLINE float2 sph_rect_sample(const SphRect* r, float u, float v) {
   // x from the area of the sub-rectangle [x0, xu] (paper eq. 8-10).
-  float au = u * r->area + r->k;
-  float fu = (cos(au) * r->b0 - r->b1) / sin(au);
+  // au = k + u omega, by the angle-sum formulas (see cos_k): omega, accurate to float relative
+  // precision, is the range of the variable, so the sampled x keeps that precision too.
+  // cos(au) b0 - b1 and sin(au) are their values at u = 0 plus the change over du, formed
+  // separately: both are O(1) while the change is O(omega).
+  float du = u * r->omega;
+  float sh = sin(0.5f * du), sdu = sin(du);
+  float omc = 2.0f * sh * sh; // 1 - cos(du)
+  float sin_au = r->sin_k + (r->cos_k * sdu - r->sin_k * omc);
+  float fu = (r->n0 - r->b0 * (r->cos_k * omc + r->sin_k * sdu)) / sin_au;
   // xu = -cu z0 / sqrt(1 - cu^2) with cu = sign(fu) / sqrt(fu^2 + b0^2), simplified so that
   // 1 - cu^2 does not cancel: xu = sign(fu) h / sqrt(fu^2 + b0^2 - 1).
   float h = -r->z0;
@@ -87,11 +103,17 @@ INLINE float2 sph_rect_sample(const SphRect* r, float u, float v) {
   }
   xu = clamp(xu, r->x0, r->x1);
   // y uniform in the sine of the elevation within the column at xu (paper eq. 11-12).
-  float dd = sqrt(xu * xu + r->z0 * r->z0);
-  float h0 = r->y0 / sqrt(dd * dd + r->y0 * r->y0);
-  float h1 = r->y1 / sqrt(dd * dd + r->y1 * r->y1);
+  // With 1 -+ h0 and 1 -+ h1 formed without cancellation, 1 - hv^2 = (1 - hv)(1 + hv) keeps its
+  // precision when hv is near +-1 (a rectangle seen far off to one side).
+  float dd = sqrt(xu * xu + r->z0 * r->z0), d2 = dd * dd;
+  float r0 = sqrt(d2 + r->y0 * r->y0), r1 = sqrt(d2 + r->y1 * r->y1);
+  float h0 = r->y0 / r0, h1 = r->y1 / r1;
+  float om0 = (r->y0 > 0.0f ? d2 / (r0 + r->y0) : r0 - r->y0) / r0; // 1 - h0
+  float op0 = (r->y0 < 0.0f ? d2 / (r0 - r->y0) : r0 + r->y0) / r0; // 1 + h0
+  float om1 = (r->y1 > 0.0f ? d2 / (r1 + r->y1) : r1 - r->y1) / r1;
+  float op1 = (r->y1 < 0.0f ? d2 / (r1 - r->y1) : r1 + r->y1) / r1;
   float hv = h0 + v * (h1 - h0);
-  float c2 = (1.0f - hv) * (1.0f + hv);
+  float c2 = ((1.0f - v) * om0 + v * om1) * ((1.0f - v) * op0 + v * op1);
   float yv = c2 > 0.0f ? hv * dd / sqrt(c2) : (hv > 0.0f ? r->y1 : r->y0);
   yv = clamp(yv, r->y0, r->y1);
   return make_float2(xu, yv);

@@ -10,14 +10,12 @@
 #include "../compat.h"
 
 typedef struct SphTri {
-  float3 A, B, C;  // unit directions towards the vertices
-  float3 t_ac;     // unit tangent of the arc A -> C at A
-  float cos_alpha; // angle at vertex A (between the arcs A->B and A->C)
-  float sin_alpha;
-  float alpha;
-  float cos_c; // A . B (c: the arc opposite C)
-  float area;  // alpha + beta + gamma - pi: the range of Arvo's first variable
-  float omega; // solid angle for the pdf (see sph_tri_setup)
+  float3 A, B, C;   // unit directions towards the vertices
+  float3 t_ac;      // unit tangent of the arc A -> C at A
+  float alpha;      // angle at vertex A (between the arcs A->B and A->C)
+  float tan_half_c; // tan(c / 2), c the arc A -> B
+  float area;       // alpha + beta + gamma - pi
+  float omega;      // solid angle for the pdf and the sampler (see sph_tri_setup)
 } SphTri;
 
 // a, b, c: vertices relative to the viewpoint; ab = b - a, ac = c - a, bc = c - b computed from
@@ -41,10 +39,9 @@ INLINE SphTri sph_tri_setup(float3 a, float3 b, float3 c, float3 ab, float3 ac, 
   t.alpha = atan2(sa, ca);
   float beta = atan2(sb, cb);
   float gamma = atan2(sc, cc);
-  float ra = sqrt(sa * sa + ca * ca);
-  t.cos_alpha = ra > 0.0f ? ca / ra : 1.0f;
-  t.sin_alpha = ra > 0.0f ? sa / ra : 0.0f;
-  t.cos_c = dot(t.A, t.B);
+  // tan(c/2) = |a x b| / (|a||b| + a.b): no cosine of a short arc
+  float tden = la * lb + dot(a, b);
+  t.tan_half_c = tden > 0.0f ? length(n_ab) / tden : FLT_INF;
   float3 tac = ac - t.A * dot(ac, t.A);
   float ltac = length(tac);
   t.t_ac = ltac > 0.0f ? tac / ltac : make_float3(0.0f, 0.0f, 0.0f);
@@ -69,16 +66,26 @@ INLINE SphTri sph_tri_setup(float3 a, float3 b, float3 c, float3 ab, float3 ac, 
 // First a point C' on the arc A -> C such that the triangle A B C' has area u1 * area, then a
 // point on the arc B -> C' uniform in 1 - cos of its distance to B.
 INLINE float3 sph_tri_sample(const SphTri* t, float u1, float u2) {
-  float ah = u1 * t->area;
-  float sp = sin(ah - t->alpha), cp = cos(ah - t->alpha);
-  float uu = cp - t->cos_alpha;
-  float vv = sp + t->sin_alpha * t->cos_c;
-  float num = (vv * cp - uu * sp) * t->cos_alpha - vv;
-  float den = (vv * sp + uu * cp) * t->sin_alpha;
-  float q = num / den;          // cos of the arc A -> C'
-  if (!(q >= -1.0f)) q = -1.0f; // also a 0/0 of a degenerate triangle
-  if (!(q <= 1.0f)) q = 1.0f;
-  float3 c1 = t->A * q + t->t_ac * sqrt(fmax(0.0f, 1.0f - q * q));
+  // Arvo finds cos(b'), b' = the arc A -> C', from the area; a short arc is then lost in the
+  // cosine (sqrt(1 - cos^2) has absolute error ~ sqrt(eps)). Instead, the excess E of a spherical
+  // triangle with sides c, b' and included angle alpha satisfies the standard identity
+  // tan(E/2) = tan(b'/2) tan(c/2) sin(alpha) / (1 + tan(b'/2) tan(c/2) cos(alpha)), which solved
+  // for tan(b'/2) with E = u1 * area is well conditioned:
+  //   tan(b'/2) = sin(E/2) / (tan(c/2) sin(alpha - E/2)).
+  float e2 = 0.5f * u1 * t->omega; // omega rather than the angle sum: relative precision
+  float num = sin(e2), den = t->tan_half_c * sin(t->alpha - e2);
+  float cos_b, sin_b;
+  if (!(num < den)) {
+    // tan(b'/2) >= 1 (b' >= pi/2): the same in 1 / tan(b'/2) (den 0 -> b' = pi)
+    float y = num > 0.0f ? fmax(den, 0.0f) / num : 1.0f;
+    cos_b = (y * y - 1.0f) / (y * y + 1.0f);
+    sin_b = 2.0f * y / (y * y + 1.0f);
+  } else {
+    float x = num / den;
+    cos_b = (1.0f - x * x) / (1.0f + x * x);
+    sin_b = 2.0f * x / (1.0f + x * x);
+  }
+  float3 c1 = t->A * cos_b + t->t_ac * sin_b;
   // 1 - C'.B as |C' - B|^2 / 2, and the tangent at B from C' - B: both keep their precision when
   // C' is close to B.
   float3 dcb = c1 - t->B;
