@@ -147,23 +147,36 @@ INLINE PlanarView planar_view(const GLOBAL Light* l, float3 P) {
     v.py = -dot(dp, v.fy);
     v.e2x = dot(e2, v.fx);
     v.e2y = dot(e2, v.fy);
-    // The foot of P on the plane is the frame's (0, 0): its parameters, clamped into the light.
+    // The foot of P on the plane is the frame's (0, 0): the apex when it lies on the light.
     float fb = -v.py / v.e2y;
     float fa = (-v.px - fb * v.e2x) / v.l1;
-    float2 f = planar_clamp(fa, fb, v.corners);
-    v.fa = f.x;
-    v.fb = f.y;
     for (int i = 0; i < v.corners; ++i) {
       float2 c = planar_corner(i, v.corners);
       v.cx[i] = v.px + c.x * v.l1 + c.y * v.e2x;
       v.cy[i] = v.py + c.y * v.e2y;
     }
-    if (f.x == fa && f.y == fb) {
-      v.bx = 0.0f;
-      v.by = 0.0f;
-    } else {
-      v.bx = v.px + f.x * v.l1 + f.y * v.e2x;
-      v.by = v.py + f.y * v.e2y;
+    float2 f = planar_clamp(fa, fb, v.corners);
+    v.fa = fa;
+    v.fb = fb;
+    if (!(f.x == fa && f.y == fb)) {
+      // Foot outside: the nearest point of the light's boundary (in the plane, not in the
+      // parameters, which a skewed light would move far from the foot, towards the horizon).
+      float best = FLT_INF;
+      for (int i = 0; i < v.corners; ++i) {
+        int j = (i + 1) % v.corners;
+        float dx = v.cx[j] - v.cx[i], dy = v.cy[j] - v.cy[i];
+        float t = clamp(-(v.cx[i] * dx + v.cy[i] * dy) / (dx * dx + dy * dy), 0.0f, 1.0f);
+        float qx = v.cx[i] + t * dx, qy = v.cy[i] + t * dy;
+        float q2 = qx * qx + qy * qy;
+        if (q2 < best) {
+          float2 ci = planar_corner(i, v.corners), cj = planar_corner(j, v.corners);
+          best = q2;
+          v.bx = qx;
+          v.by = qy;
+          v.fa = ci.x + t * (cj.x - ci.x);
+          v.fb = ci.y + t * (cj.y - ci.y);
+        }
+      }
     }
     for (int i = 0; i < v.corners; ++i) {
       SphTri t = planar_fan_triangle(&v, i);

@@ -18,6 +18,19 @@ typedef struct SphTri {
   float omega;      // solid angle for the pdf and the sampler (see sph_tri_setup)
 } SphTri;
 
+// a x b, which equals a x d for d = b - a: each component from whichever form has the smaller
+// rounding bound (b - a for a distant short edge, b for a vertex near the viewpoint's foot).
+INLINE float3 sph_cross(float3 a, float3 b, float3 d) {
+  float3 r1 = cross(a, b), r2 = cross(a, d);
+  float3 fa = fabs(a), fb = fabs(b), fd = fabs(d);
+  float3 e1 =
+      make_float3(fa.y * fb.z + fa.z * fb.y, fa.z * fb.x + fa.x * fb.z, fa.x * fb.y + fa.y * fb.x);
+  float3 e2 =
+      make_float3(fa.y * fd.z + fa.z * fd.y, fa.z * fd.x + fa.x * fd.z, fa.x * fd.y + fa.y * fd.x);
+  return make_float3(e1.x < e2.x ? r1.x : r2.x, e1.y < e2.y ? r1.y : r2.y,
+                     e1.z < e2.z ? r1.z : r2.z);
+}
+
 // a, b, c: vertices relative to the viewpoint; ab = b - a, ac = c - a, bc = c - b computed from
 // the light's edges; abs_t = |a . (b x c)| (= plane distance * twice the triangle's area).
 INLINE SphTri sph_tri_setup(float3 a, float3 b, float3 c, float3 ab, float3 ac, float3 bc,
@@ -27,12 +40,12 @@ INLINE SphTri sph_tri_setup(float3 a, float3 b, float3 c, float3 ab, float3 ac, 
   t.A = a / la;
   t.B = b / lb;
   t.C = c / lc;
-  // Normals of the great circles through the edges, from the accurate edge vectors:
-  // a x b = a x (b - a) etc. The angle at a vertex is the angle between the two normals there;
+  // Normals of the great circles through the edges, from the accurate edge vectors or the
+  // vertices (sph_cross). The angle at a vertex is the angle between the two normals there;
   // |(a x b) x (a x c)| = |a . (b x c)| |a|, so each angle is an atan2 of accurate terms.
-  float3 n_ab = cross(a, ab);
-  float3 n_ac = cross(a, ac);
-  float3 n_bc = cross(b, bc);
+  float3 n_ab = sph_cross(a, b, ab);
+  float3 n_ac = sph_cross(a, c, ac);
+  float3 n_bc = sph_cross(b, c, bc);
   float ca = dot(n_ab, n_ac), sa = abs_t * la;
   float cb = -dot(n_ab, n_bc), sb = abs_t * lb;
   float cc = dot(n_ac, n_bc), sc = abs_t * lc;
