@@ -4,12 +4,13 @@
 // pdf of the technique sample_light() used.
 // - Rectangles (edges orthogonal to 1e-4 relative): Urena et al.'s spherical rectangle.
 // - Triangles and other parallelograms: a fan of spherical triangles from the apex F, the point
-//   of the light nearest (in its parameter space) to the foot of the shading point on the light's
-//   plane; one fan triangle is chosen with probability proportional to its solid angle, then
-//   sampled by Arvo's method with F as the vertex the second arc starts from. The union is
-//   uniform in solid angle, pdf = 1 / omega. The apex makes a viewpoint almost on the plane well
-//   conditioned: every arc from F then starts near the nadir, where a whole triangle seen from
-//   1e-6 above would otherwise be a spherical triangle with all three vertices on the horizon.
+//   of the light nearest to the foot of the shading point on the light's plane (the foot itself
+//   when it lies on the light); one fan triangle is chosen with probability proportional to its
+//   solid angle, then sampled by Arvo's method with F as the vertex the second arc starts from. The
+//   union is uniform in solid angle, pdf = 1 / omega. The apex makes a viewpoint almost on the
+//   plane well conditioned: every arc from F then starts near the nadir, where a whole triangle
+//   seen from 1e-6 above would otherwise be a spherical triangle with all three vertices on the
+//   horizon.
 // - Both samplers take their range from a solid angle accurate to float relative precision (Van
 //   Oosterom & Strackee's formula where the angle sum, which loses ~1e-6 sr to cancellation, is
 //   small) and map it with formulas that keep that precision (spherical_*.h): perturbing every
