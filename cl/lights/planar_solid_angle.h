@@ -126,6 +126,28 @@ INLINE PlanarView planar_view(const GLOBAL Light* l, float3 P) {
     return v;
   }
   if (!(fabs(v.hs) > 0.0f)) return v; // on the plane (or NaN): area sampling reports pdf 0
+  // Most lights of a many-light scene are small and far: a bound decides without the spherical
+  // set-up. omega = integral of cos / d^2 dA <= A h / d_min^3, d_min >= (distance to the
+  // centroid) - (radius about it). Not exactly conservative in float, which only moves a light
+  // within rounding of the threshold to area sampling: the choice stays a function of (l, P).
+  {
+    float3 c, r1, r2, r3;
+    if (v.corners == 4) {
+      c = (e1 + e2) * 0.5f;
+      r1 = c;
+      r2 = (e1 - e2) * 0.5f;
+      r3 = r2;
+    } else {
+      c = (e1 + e2) * (1.0f / 3.0f);
+      r1 = c;
+      r2 = e1 - c;
+      r3 = e2 - c;
+    }
+    float rad = sqrt(fmax(dot(r1, r1), fmax(dot(r2, r2), dot(r3, r3))));
+    float dmin = fmax(length(c - dp) - rad, fabs(v.hs));
+    float bound = l->n.w * (fabs(v.hs) / dmin) / (dmin * dmin);
+    if (bound < LIGHT_SOLID_ANGLE_MIN) return v;
+  }
   float omega = 0.0f;
   int technique = PLANAR_FAN;
 #if HAS_LIGHT_QUAD
