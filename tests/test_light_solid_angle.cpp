@@ -189,6 +189,33 @@ TEST(LightSolidAngle, TechniqueChoice) {
   }
 }
 
+// The technique is solid angle exactly when the light's solid angle is at least
+// LIGHT_SOLID_ANGLE_MIN (the cheap bound that skips the set-up for far lights never decides
+// otherwise, away from rounding).
+TEST(LightSolidAngle, FallbackCriterion) {
+  Rng rng(11);
+  int near_threshold = 0;
+  for (const NamedLight& nl : test_lights()) {
+    for (int k = 0; k < 4000; ++k) {
+      // directions below the light, distances around where the solid angle crosses 1e-3 sr
+      float z = -rng.next(), phi = 6.2831853f * rng.next();
+      float sxy = std::sqrt(std::max(0.0f, 1 - z * z));
+      float dist = 40.0f * std::pow(10.0f, -1.3f * rng.next());
+      float3 P =
+          make_float3(dist * sxy * std::cos(phi), 1.0f + dist * z, dist * sxy * std::sin(phi));
+      double omega = polygon_omega(corners(nl.l), d3(P));
+      PlanarView v = planar_view(&nl.l, P);
+      if (omega >= 1.001 * LIGHT_SOLID_ANGLE_MIN) {
+        EXPECT_NE(v.technique, PLANAR_AREA) << nl.name << " omega " << omega;
+      } else if (omega < 0.999 * LIGHT_SOLID_ANGLE_MIN) {
+        EXPECT_EQ(v.technique, PLANAR_AREA) << nl.name << " omega " << omega;
+      }
+      near_threshold += omega > 0.5 * LIGHT_SOLID_ANGLE_MIN && omega < 2 * LIGHT_SOLID_ANGLE_MIN;
+    }
+  }
+  EXPECT_GT(near_threshold, 1000); // the test looks where the choice changes
+}
+
 // The pdf integrates to 1 over the light's solid angle: whatever the technique, the pdf of every
 // direction times the exact solid angle (quadrature of cos / d^2 over the light in double,
 // against the closed form) integrates to 1.
