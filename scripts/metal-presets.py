@@ -16,8 +16,13 @@ Sources:
   Al:         A. D. Rakic, Algorithm for the determination of intrinsic optical constants of metal
               films: application to aluminum, Appl. Opt. 34, 4755-4767 (1995)  (Rakic.yml)
 
-Usage: scripts/metal-presets.py   (prints the C++ table rows)
+Usage: scripts/metal-presets.py                (prints the C++ table rows)
+       scripts/metal-presets.py --check FILE   (exit 1 unless FILE's table has exactly these values;
+                                                ctest SceneMetalPresetsMatchScript)
 """
+
+import re
+import sys
 
 WAVELENGTHS_NM = (650.0, 550.0, 450.0)  # R, G, B
 
@@ -70,7 +75,36 @@ def normal_reflectance(n, k):
     return ((n - 1) ** 2 + k ** 2) / ((n + 1) ** 2 + k ** 2)
 
 
+def presets():
+    """name -> (eta triple, k triple), each value rounded to 3 decimals, in table order."""
+    out = {}
+    for name, (_, rows) in TABLES.items():
+        nk = [interp(rows, w / 1000.0) for w in WAVELENGTHS_NM]
+        out[name] = (tuple(round(n, 3) for n, _ in nk), tuple(round(k, 3) for _, k in nk))
+    return out
+
+
+def check(path):
+    text = open(path, encoding="utf-8").read()
+    num = r"\s*([0-9.]+)f\s*"
+    row = re.compile(r'\{"(\w+)",\s*\{' + ",".join([num] * 3) + r"\},\s*\{" +
+                     ",".join([num] * 3) + r"\}\}")
+    found = {m.group(1): (tuple(float(m.group(i)) for i in (2, 3, 4)),
+                          tuple(float(m.group(i)) for i in (5, 6, 7)))
+             for m in row.finditer(text)}
+    want = presets()
+    if list(found) != list(want):
+        print(f"{path}: presets {list(found)}, expected {list(want)}")
+        return 1
+    bad = [n for n in want if found[n] != want[n]]
+    for n in bad:
+        print(f"{path}: {n}: eta, k = {found[n]}, the data give {want[n]}")
+    return 1 if bad else 0
+
+
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--check":
+        sys.exit(check(sys.argv[2]))
     for name, (src, rows) in TABLES.items():
         nk = [interp(rows, w / 1000.0) for w in WAVELENGTHS_NM]
         eta = ", ".join(f"{n:.3f}f" for n, _ in nk)
