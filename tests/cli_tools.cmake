@@ -96,8 +96,9 @@ elseif(MODE STREQUAL "converge")
   endforeach()
   # The mis column (last): /nomis renders with MIS off, every other configuration with MIS on.
   file(STRINGS "${DIR}/tiny-configs.csv" cfg_rows)
-  foreach(re "^tiny,tree-split:0.5/nomis,tree-split,0.5,.*,0$" "^tiny,tree-split:0.5,tree-split,0.5,.*,1$"
-             "^tiny,power,power,.*,1$")
+  foreach(re "^tiny_converge,tree-split:0.5/nomis,tree-split,0.5,.*,0$"
+             "^tiny_converge,tree-split:0.5,tree-split,0.5,.*,1$"
+             "^tiny_converge,power,power,.*,1$")
     set(hits ${cfg_rows})
     list(FILTER hits INCLUDE REGEX "${re}")
     list(LENGTH hits n)
