@@ -191,11 +191,6 @@ int run_render(const RenderArgs& args) {
         "--no-orientation: applies to the tree samplers only (tree, tree-split), not {}",
         scene.integrator.light_sampler));
   if (args.no_mis) scene.integrator.mis = false;
-  // The bsdf sampler samples the BSDF only: there is no light sample to combine with.
-  if (!scene.integrator.mis && scene.integrator.light_sampler == "bsdf")
-    throw SceneError(fmt::format("{}: MIS off (--no-mis or integrator mis false) does not apply "
-                                 "to the bsdf light sampler (BSDF sampling only)",
-                                 args.no_mis ? "--no-mis" : printable(args.scene, 1024)));
 
   auto [exr, png] = output_paths(args);
   check_writable(exr, args.out.empty() ? "output" : "--out");
@@ -356,8 +351,8 @@ int main(int argc, char** argv) {
   render->add_flag("--no-mis", rargs.no_mis,
                    "No multiple importance sampling: light sampling alone gives direct light at "
                    "non-delta vertices, and BSDF-sampled rays that hit an emitter count only after "
-                   "delta bounces (overrides the scene's integrator mis; the ablation of "
-                   "docs/results.md)");
+                   "delta bounces (overrides the scene's integrator mis; no effect on the bsdf "
+                   "sampler; the ablation of docs/results.md)");
   render->add_option("--device", rargs.device, "OpenCL device name substring (see `canopy info`)");
   render->add_flag("--stats", rargs.stats, "Print per-stage times, throughput and cut sizes");
   render->add_option("--stats-json", rargs.stats_json, "Write the statistics as JSON to FILE");
