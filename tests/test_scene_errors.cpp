@@ -234,6 +234,11 @@ TEST(SceneErrors, MaxCutOutOfRange) {
             "scene.json: integrator.max_cut: must be an integer");
 }
 
+TEST(SceneErrors, MisNotABool) {
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"mis": 0})")),
+            "scene.json: integrator.mis: must be true or false");
+}
+
 TEST(SceneErrors, SeedNegative) {
   EXPECT_EQ(error_of(scene_with(R"("integrator": {"seed": -1})")),
             "scene.json: integrator.seed: must be in [0, 4294967295]");

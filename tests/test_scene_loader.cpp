@@ -31,7 +31,7 @@ TEST(SceneLoader, CameraFilmIntegrator) {
     "camera": {"position": [1, 2, 3], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 60},
     "film": {"width": 320, "height": 200},
     "integrator": {"spp": 7, "max_depth": 4, "light_sampler": "tree-split",
-                   "split_threshold": 0.5, "max_cut": 9, "seed": 4294967295},
+                   "split_threshold": 0.5, "max_cut": 9, "seed": 4294967295, "mis": false},
     "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}]
   })");
   EXPECT_FLOAT_EQ(s.camera.position.x, 1);
@@ -47,6 +47,7 @@ TEST(SceneLoader, CameraFilmIntegrator) {
   EXPECT_FLOAT_EQ(s.integrator.split_threshold, 0.5f);
   EXPECT_EQ(s.integrator.max_cut, 9);
   EXPECT_EQ(s.integrator.seed, 4294967295u);
+  EXPECT_FALSE(s.integrator.mis);
   EXPECT_EQ(s.path, "scene.json");
 }
 
@@ -63,6 +64,7 @@ TEST(SceneLoader, Defaults) {
   EXPECT_FLOAT_EQ(s.integrator.split_threshold, LT_DEFAULT_SPLIT_THRESHOLD);
   EXPECT_EQ(s.integrator.max_cut, 64);
   EXPECT_EQ(s.integrator.seed, 1u);
+  EXPECT_TRUE(s.integrator.mis);
   ASSERT_EQ(s.materials.size(), 1u);
   EXPECT_EQ(s.materials[0].name, "default");
   EXPECT_FLOAT_EQ(s.materials[0].gpu.albedo.x, 0.8f);

@@ -234,13 +234,14 @@ void parse_film(const JsonValue& v, FilmSettings& film) {
 
 void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
   auto o = v.as_object();
-  o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "max_cut", "seed"});
+  o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "max_cut", "seed", "mis"});
   if (auto x = o.get("spp")) in.spp = int(x->as_int(1, kMaxSpp));
   if (auto x = o.get("max_depth")) in.max_depth = int(x->as_int(1, kMaxDepth));
   if (auto x = o.get("light_sampler")) in.light_sampler = x->as_enum(kLightSamplerNames);
   if (auto x = o.get("split_threshold")) in.split_threshold = x->as_float_in(0.0f, 1.0f);
   if (auto x = o.get("max_cut")) in.max_cut = int(x->as_int(1, kMaxMaxCut));
   if (auto x = o.get("seed")) in.seed = uint32_t(x->as_int(0, 0xffffffffLL));
+  if (auto x = o.get("mis")) in.mis = x->as_bool();
 }
 
 // One entry of "materials" (docs/scene-format.md, Materials). Roughness r becomes GGX alpha = r^2.
