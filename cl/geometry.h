@@ -233,4 +233,21 @@ INLINE float3 primitive_normal(const GLOBAL Primitive* prim, float3 p) {
   return normalize(cross(xyz_of(prim->e1), xyz_of(prim->e2)));
 }
 
+// Shading normal at barycentrics (u, v) of a hit on p (Phong shading: the vertex normals
+// interpolated like the hit point, v0 + u e1 + v e2), normalised and turned to the side of the
+// geometric normal Ng (vertex normals that disagree with the winding are taken as flipped).
+// Flat triangles and spheres (p->normals < 0) give Ng, and so does an interpolant shorter than
+// 1e-4 (vertex normals that nearly cancel: its direction would be rounding noise).
+INLINE float3 primitive_shading_normal(const GLOBAL Primitive* p, GLOBAL const float4* normals,
+                                       float u, float v, float3 Ng) {
+  if (p->type != PRIM_TRIANGLE || p->normals < 0) return Ng;
+  int i = p->normals;
+  float3 n =
+      xyz_of(normals[i]) * (1.0f - u - v) + xyz_of(normals[i + 1]) * u + xyz_of(normals[i + 2]) * v;
+  float len2 = dot(n, n);
+  if (!(len2 > 1e-8f)) return Ng;
+  n = n * (1.0f / sqrt(len2));
+  return dot(n, Ng) < 0.0f ? n * -1.0f : n;
+}
+
 #endif // CANOPY_CL_GEOMETRY_H

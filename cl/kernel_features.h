@@ -16,6 +16,11 @@
 #define HAS_MATERIAL_PLASTIC 1
 #endif
 
+// MIS between light and BSDF sampling (RendererOptions::mis; off only for the ablation).
+#ifndef CANOPY_MIS
+#define CANOPY_MIS 1
+#endif
+
 // `x` has type T and the kernel has feature T: folds to 0 when the feature is off. (A ternary:
 // `HAS_T && ...` inside || draws clang's -Wconstant-logical-operand in the kernel build.)
 #define IS_LIGHT(l, T) (HAS_##T ? (l)->type == T : 0)

@@ -7,6 +7,9 @@
 #include "kernel_features.h"
 #include "shading.h"
 #include "types.h"
+#if HAS_LIGHT_QUAD || HAS_LIGHT_TRIANGLE
+#include "lights/planar_solid_angle.h"
+#endif
 
 typedef struct LightSample {
   float3 wi;    // unit direction from the shading point towards the light point
@@ -40,6 +43,15 @@ INLINE float spot_falloff(const GLOBAL Light* l, float w_axis_dist2) {
 INLINE int light_emits_towards(const GLOBAL Light* l, float3 w) {
   if (l->flags & LIGHT_FLAG_TWO_SIDED) return 1;
   return dot(xyz_of(l->n), w) > 0.0f;
+}
+
+// Where a shadow ray towards the point q on a quad or triangle light ends: q moved off the
+// light's plane towards P by q's rounding error and that of the light's geometry triangles
+// (their vertices are p + e1 etc. rounded): gamma(3) of each term, twice.
+INLINE float3 area_light_shadow_end(const GLOBAL Light* l, float3 q, float3 P) {
+  float3 q_err = (fabs(xyz_of(l->p)) + fabs(xyz_of(l->e1)) + fabs(xyz_of(l->e2))) * fp_gamma(6);
+  float3 ln = xyz_of(l->n);
+  return offset_ray_origin(q, q_err, dot(ln, P - q) >= 0.0f ? ln : -ln);
 }
 
 INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float u2) {
@@ -111,8 +123,23 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
     }
     return s;
   }
-  // Quad and triangle: uniform in area, converted to solid angle.
+  // Quad and triangle: uniform in solid angle where float precision allows, else uniform in area
+  // converted to solid angle (cl/lights/planar_solid_angle.h).
   if (!(IS_LIGHT(l, LIGHT_QUAD) || IS_LIGHT(l, LIGHT_TRIANGLE))) return s;
+  float3 q;
+#if HAS_LIGHT_QUAD || HAS_LIGHT_TRIANGLE
+  PlanarView view = planar_view(l, P);
+  if (view.technique == PLANAR_NONE) return s;
+  if (view.technique != PLANAR_AREA) {
+    float2 ab = planar_sample_solid_angle(&view, u1, u2, &s.wi, &s.dist);
+    q = xyz_of(l->p) + xyz_of(l->e1) * ab.x + xyz_of(l->e2) * ab.y;
+    s.x = area_light_shadow_end(l, q, P);
+    if (!(s.dist > 0.0f) || !light_emits_towards(l, -s.wi)) return s;
+    s.Li = L;
+    s.pdf = 1.0f / view.omega;
+    return s;
+  }
+#endif
   float3 q1, q2;
   if (IS_LIGHT(l, LIGHT_QUAD)) {
     q1 = xyz_of(l->e1) * u1;
@@ -122,12 +149,8 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
     q1 = xyz_of(l->e1) * (1.0f - su);
     q2 = xyz_of(l->e2) * (u2 * su);
   }
-  float3 q = xyz_of(l->p) + q1 + q2;
-  // Off the light's plane towards P by q's rounding error and that of the light's geometry
-  // triangles (their vertices are p + e1 etc. rounded): gamma(3) of each term, twice.
-  float3 q_err = (fabs(xyz_of(l->p)) + fabs(xyz_of(l->e1)) + fabs(xyz_of(l->e2))) * fp_gamma(6);
-  float3 ln = xyz_of(l->n);
-  s.x = offset_ray_origin(q, q_err, dot(ln, P - q) >= 0.0f ? ln : -ln);
+  q = xyz_of(l->p) + q1 + q2;
+  s.x = area_light_shadow_end(l, q, P);
   float3 to = q - P;
   float d2 = dot(to, to);
   if (!(d2 > 0.0f)) return s;
@@ -165,6 +188,11 @@ INLINE float light_pdf(const GLOBAL Light* l, float3 P, float3 x) {
     return 1.0f / (2.0f * CANOPY_PI * (sin2_max / (1.0f + cos_max)));
   }
   if (IS_LIGHT(l, LIGHT_QUAD) || IS_LIGHT(l, LIGHT_TRIANGLE)) {
+#if HAS_LIGHT_QUAD || HAS_LIGHT_TRIANGLE
+    PlanarView view = planar_view(l, P);
+    if (view.technique == PLANAR_NONE) return 0.0f;
+    if (view.technique != PLANAR_AREA) return 1.0f / view.omega;
+#endif
     float3 to = x - P;
     float d2 = dot(to, to);
     if (!(d2 > 0.0f)) return 0.0f;

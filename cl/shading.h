@@ -23,6 +23,47 @@ INLINE float3 sample_cosine_hemisphere(float3 n, float u1, float u2) {
   return normalize(t * (r * cos(phi)) + b * (r * sin(phi)) + n * z);
 }
 
+// An orthonormal shading frame: n is the shading normal, the BSDFs work in (t, b, n) coordinates
+// (cl/bsdf/bsdf.h: z up).
+typedef struct Frame {
+  float3 t, b, n;
+} Frame;
+
+INLINE Frame frame_from(float3 n) {
+  Frame f;
+  f.n = n;
+  onb_from(n, &f.t, &f.b);
+  return f;
+}
+INLINE float3 frame_to_local(const Frame* f, float3 w) {
+  return make_float3(dot(w, f->t), dot(w, f->b), dot(w, f->n));
+}
+INLINE float3 frame_to_world(const Frame* f, float3 w) {
+  return f->t * w.x + f->b * w.y + f->n * w.z;
+}
+
+// A shading normal ns (interpolated vertex normals) usable for the direction wo towards the
+// viewer on the side of the geometric normal ng (both unit, dot(ng, wo) > 0). Interpolated normals
+// can put wo below ns's horizon or reflect it into the surface, which shows as black fringes on
+// smooth meshes; as Cycles does (ensure_valid_reflection), ns is tilted towards ng just enough
+// that the mirror direction of wo about it stays above the geometric surface by
+// q = min(0.9 dot(ng, wo), 0.01). The tilted normal is the half vector of wo and that direction,
+// so dot(ns, wo) > 0 afterwards. A flat surface (ns == ng) is returned unchanged.
+INLINE float3 shading_normal_fix(float3 ng, float3 wo, float3 ns) {
+  if (dot(ns, ng) < 0.0f) ns = -ns;
+  float3 r = ns * (2.0f * dot(ns, wo)) - wo; // mirror direction of wo about ns
+  float q = fmin(0.9f * dot(ng, wo), 0.01f);
+  float rh = dot(r, ng);
+  if (rh >= q) return ns;
+  float3 x = r - ng * rh; // the part of r in the surface plane
+  float xl = length(x);
+  if (!(xl > 0.0f)) return ng;
+  float3 r2 = x * (sqrt(fmax(0.0f, 1.0f - q * q)) / xl) + ng * q;
+  float3 h = wo + r2;
+  float hl = length(h);
+  return hl > 0.0f ? h / hl : ng;
+}
+
 // Floating-point error bounds (pbrt-v4 §6.8): gamma(n) = n u / (1 - n u) bounds the relative
 // error of n successive float operations, u = 2^-24 the unit roundoff.
 INLINE float fp_gamma(int n) {

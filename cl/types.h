@@ -64,7 +64,9 @@ typedef struct Primitive {
   int type;
   int material; // index into materials
   int light;    // index of the light this primitive shows, or -1
-  int pad;
+  // triangle with vertex normals: index of the first of its three shading normals (float4 xyz,
+  // unit, in the order v0, v1, v2; cl/geometry.h primitive_shading_normal); -1: flat (or sphere)
+  int normals;
 } Primitive;
 
 // 4-wide BVH node, struct of arrays: lane i of each float4 is child i's box, so one node's four

@@ -3,6 +3,11 @@
 <scene>.csv, <scene>-median.csv, <scene>-configs.csv, <scene>-reference.json and the PNGs.
 Run by scripts/make-results.sh; standard library only.
 
+Two groups of scenes: the many-light scenes of issues 5 and 10 (SCENES: light samplers and split
+thresholds, the targets and the paper's claims) and the glossy scenes of issue 11 (GLOSSY_SCENES:
+tree-split, power and BSDF-only sampling, each light sampler with and without MIS; the baseline of
+issue 12). A group's summary covers only its own scenes.
+
 Equal-time error: each configuration's median curve (RMSE against render seconds) is interpolated
 in log-log; outside its measured range it is extended with the Monte Carlo rate RMSE ~ t^-1/2 from
 the nearest end (marked with *).
@@ -24,6 +29,20 @@ SCENES = [
     ("plane-10k", "10,000 point lights over a diffuse plane (pbrt-v4's many-light test; "
                   "scripts/gen-plane-lights.py)"),
 ]
+# Issue 11: glossy scenes (Liu, Xu & Yan 2019), rendered with GLOSSY_CONFIGS (make-results.sh).
+GLOSSY_SCENES = [
+    ("glossy-cornell", "Plastic objects in a Cornell box lit by 10^4 tiny sphere lights on the side "
+                       "walls (Liu et al. 2019, Fig. 14; scripts/gen-glossy-cornell.py)"),
+    ("showroom", "A gold car-like object on a polished floor, 3,744 small disk lights around and "
+                 "above it and one large quad light (Liu et al. 2019, Fig. 1; "
+                 "scripts/gen-showroom.py)"),
+]
+# Configuration labels of the glossy scenes: "/nomis" is the same light sampler with MIS off;
+# "bsdf" samples the BSDF only (no light sampling, so no MIS variant). "tree-split" has the
+# scene's (default) threshold.
+GLOSSY_TREE = "tree-split"
+GLOSSY_LIGHT_SAMPLERS = ["tree-split", "power"]
+NOMIS = "/nomis"
 # The default split threshold (LT_DEFAULT_SPLIT_THRESHOLD in cl/light_tree/split.h).
 DEFAULT_THRESHOLD = "tree-split:0.25"
 THRESHOLDS = ["tree-split:0.0", "tree-split:0.25", "tree-split:0.5", "tree-split:0.85", "tree-split:0.95"]
@@ -115,6 +134,16 @@ class Scene:
         pts = sum(float(r["shading_points"]) for r in self.runs if r["sampler"] == label)
         return rays / pts if pts else math.nan
 
+    def mse_time(self, label):
+        """Inverse efficiency, MSE x render seconds, at the curve's last (highest-spp) point: for a
+        Monte Carlo estimator it does not depend on the time, so it compares configurations that
+        reach different spp (lower is better)."""
+        pts = self.curves.get(label, [])
+        if not pts:
+            return math.nan
+        t, r, _, _ = pts[-1]
+        return r * r * t
+
     def best_split(self):
         cands = [l for l in THRESHOLDS if l in self.eq]
         return min(cands, key=lambda l: self.eq[l][0]) if cands else None
@@ -129,7 +158,7 @@ class Scene:
         return worst < 1.0, worst
 
 
-def scene_section(s, clamp, seeds):
+def scene_section(s, clamp, seeds, docs, glossy=False):
     out = []
     meta = s.reference.get("test", {}).get("metadata", {})
     ref_desc = ", ".join(f"{k.split(':', 1)[1]} {v}" for k, v in sorted(meta.items())
@@ -148,9 +177,18 @@ def scene_section(s, clamp, seeds):
     out.append(f"Equal-time RMSE at **{s.t_eq:.3g} s** of render time per image (the longest time "
                f"every curve reaches; values marked * are extended from the curve's end with "
                f"the t^-1/2 Monte Carlo rate):\n")
-    out.append("| configuration | RMSE | vs power | vs uniform | relMSE | vs power "
-               "| shadow rays / shading point | light tree build (s) | points (max spp) |")
-    out.append("|---|---|---|---|---|---|---|---|---|")
+    # The second ratio column: against uniform for the many-light scenes, against tree-split
+    # (with MIS, the renderer's default) for the glossy ones.
+    other = GLOSSY_TREE if glossy else "uniform"
+    if glossy:
+        out.append("| configuration | MIS | RMSE | vs power | vs tree-split | relMSE | vs power "
+                   "| MSE × time (s) | shadow rays / shading point | light tree build (s) "
+                   "| points (max spp) |")
+        out.append("|---|---|---|---|---|---|---|---|---|---|---|")
+    else:
+        out.append("| configuration | RMSE | vs power | vs uniform | relMSE | vs power "
+                   "| shadow rays / shading point | light tree build (s) | points (max spp) |")
+        out.append("|---|---|---|---|---|---|---|---|---|")
     cfg = {c["sampler"]: c for c in s.configs}
     for l in s.labels:
         r, ex = s.eq[l]
@@ -158,9 +196,15 @@ def scene_section(s, clamp, seeds):
         tree_build = float(c["light_tree_seconds"])
         rel, rex = s.rel_eq[l]
         relp = s.rel_eq.get("power", (math.nan, False))[0]
-        out.append(f"| {l} | {fmt_e(r)}{'*' if ex else ''} | {fmt_r(s.ratio(l, 'power'))} | "
-                   f"{fmt_r(s.ratio(l, 'uniform'))} | {fmt_e(rel)}{'*' if rex else ''} | "
-                   f"{fmt_r(rel / relp if relp else math.nan)} | {s.rays_per_point(l):.2f} | "
+        mis = ""
+        if glossy:
+            mis = ("n/a" if c.get("light_sampler") == "bsdf" else
+                   "on" if c.get("mis", "1" if NOMIS not in l else "0") == "1" else "off") + " | "
+        eff = f"{fmt_e(s.mse_time(l))} | " if glossy else ""
+        out.append(f"| {l} | {mis}{fmt_e(r)}{'*' if ex else ''} | {fmt_r(s.ratio(l, 'power'))} | "
+                   f"{fmt_r(s.ratio(l, other))} | {fmt_e(rel)}{'*' if rex else ''} | "
+                   f"{fmt_r(rel / relp if relp else math.nan)} | {eff}"
+                   f"{s.rays_per_point(l):.2f} | "
                    f"{tree_build:.3f} | {len(s.curves[l])} ({c['max_spp']}) |")
     out.append("")
     out.append(f"At equal shadow rays ({s.r_eq:.3g} per image, the most every curve reaches): " +
@@ -168,7 +212,7 @@ def scene_section(s, clamp, seeds):
                          for l in s.labels) + ".\n")
     out.append(f"![{s.name}: RMSE against time](results/{s.name}-time.png)\n")
     out.append(f"![{s.name}: RMSE against shadow rays](results/{s.name}-rays.png)\n")
-    hm = os.path.join("docs", "results", f"{s.name}-heatmap.png")
+    hm = os.path.join(docs, f"{s.name}-heatmap.png")
     if os.path.exists(hm):
         out.append(f"Shadow rays per shading point, tree-split at its default threshold (paper "
                    f"Fig. 18):\n\n![{s.name} heat map](results/{s.name}-heatmap.png)\n")
@@ -179,6 +223,75 @@ def scene_section(s, clamp, seeds):
                f"[`{s.name}-configs.csv`](results/{s.name}-configs.csv) (build and compile "
                f"times).\n")
     return "\n".join(out)
+
+
+def glossy_summary(glossy):
+    """The section of the glossy scenes (issue 11): equal-time RMSE of every light sampler with and
+    without MIS, and of BSDF sampling alone; the baseline of issue 12."""
+    o = ["## Glossy surfaces (issue 11): the baseline for issue 12\n"]
+    o.append(
+        "Glossy plastic and metal lit by thousands of small lights, after Liu, Xu & Yan 2019 "
+        "(BRDF-oriented many-light sampling): [glossy-cornell](#glossy-cornell) (their Fig. 14) "
+        "and [showroom](#showroom) (their Fig. 1). Each light sampler runs with MIS (power "
+        "heuristic between its light samples and BSDF samples) and without (`/nomis`); `bsdf` "
+        "samples the BSDF alone. RMSE at equal render time per image (the scene's equal time, "
+        "given in its section), and MSE × time (inverse efficiency at the curve's last point; "
+        "lower is better).\n")
+    o.append(
+        "**This is the baseline Liu et al.'s method must beat in issue 12**: BRDF-oriented light "
+        "sampling, with its MIS, has to reach a lower equal-time RMSE on these two scenes than the "
+        "best configuration below (marked **best**), measured by this same script.\n")
+    if not glossy:
+        o.append("Not run (neither glossy scene was rendered when the results were generated).\n")
+        return "\n".join(o)
+    o.append("| scene | light sampler | RMSE, MIS | RMSE, no MIS | no MIS / MIS | MSE × time, MIS "
+             "| MSE × time, no MIS | vs tree-split (MIS) |")
+    o.append("|---|---|---|---|---|---|---|---|")
+    for name, _ in GLOSSY_SCENES:
+        sc = glossy.get(name)
+        if not sc:
+            o.append(f"| {name} | | not run | | | | | |")
+            continue
+        best = min((l for l in sc.labels if l in sc.eq), key=lambda l: sc.eq[l][0], default=None)
+
+        def cell(label):
+            if label not in sc.eq:
+                return "not run"
+            r, ex = sc.eq[label]
+            txt = f"{fmt_e(r)}{'*' if ex else ''}"
+            return f"**{txt}** (best)" if label == best else txt
+
+        for ls in GLOSSY_LIGHT_SAMPLERS + ["bsdf"]:
+            on, off = ls, ls + NOMIS
+            if on not in sc.eq and off not in sc.eq:
+                continue
+            if ls == "bsdf":
+                o.append(f"| {name} | bsdf (BSDF sampling only) | {cell(on)} | n/a | n/a | "
+                         f"{fmt_e(sc.mse_time(on))} | n/a | {fmt_r(sc.ratio(on, GLOSSY_TREE))} |")
+                continue
+            o.append(f"| {name} | {ls} | {cell(on)} | {cell(off)} | "
+                     f"{fmt_r(sc.ratio(off, on))} | {fmt_e(sc.mse_time(on))} | "
+                     f"{fmt_e(sc.mse_time(off))} | {fmt_r(sc.ratio(on, GLOSSY_TREE))} |")
+    o.append("")
+    # One sentence per scene: what wins, and what MIS does for the tree.
+    lines = []
+    for name, _ in GLOSSY_SCENES:
+        sc = glossy.get(name)
+        if not sc or not sc.labels:
+            continue
+        best = min((l for l in sc.labels if l in sc.eq), key=lambda l: sc.eq[l][0])
+        txt = f"{name}: best at equal time ({sc.t_eq:.3g} s per image) `{best}`"
+        if GLOSSY_TREE in sc.eq and GLOSSY_TREE + NOMIS in sc.eq:
+            r = sc.ratio(GLOSSY_TREE + NOMIS, GLOSSY_TREE)
+            # A 5% margin: the seed-to-seed noise of the medians.
+            effect = ("lowers" if r > 1.05 else "raises" if r < 0.95 else
+                      "does not change (within 5%)")
+            txt += f"; MIS {effect} tree-split's error (without / with MIS {r:.2f}×)"
+        if "bsdf" in sc.eq and GLOSSY_TREE in sc.eq:
+            txt += f"; BSDF sampling alone / tree-split {sc.ratio('bsdf', GLOSSY_TREE):.2f}×"
+        lines.append("* " + txt + ".")
+    o.append("\n".join(lines) + "\n")
+    return "\n".join(o)
 
 
 def main():
@@ -193,11 +306,15 @@ def main():
     for name, _ in SCENES:
         if os.path.exists(os.path.join(a.docs, f"{name}-median.csv")):
             scenes[name] = Scene(a.docs, name)
+    glossy = {}
+    for name, _ in GLOSSY_SCENES:
+        if os.path.exists(os.path.join(a.docs, f"{name}-median.csv")):
+            glossy[name] = Scene(a.docs, name)
 
     o = []
     o.append("# Results: error against render time\n")
     o.append(f"Regenerate everything on this page (text, tables, plots) with `{a.command}` "
-             f"(about 12 minutes on 2 cores). Generated {datetime.date.today().isoformat()} at "
+             f"(about 25 minutes on 2 cores). Generated {datetime.date.today().isoformat()} at "
              f"commit `{git_commit()}` on {machine()}, OpenCL on PoCL's CPU device.\n")
     o.append(
         "Method (DESIGN.md §8): `canopy converge` renders every sampler configuration at "
@@ -220,7 +337,11 @@ def main():
         "every configuration reaches tens of spp within its budget. `tree-split:T` is adaptive "
         "splitting with threshold T (Canopy's dimensionless split measure, DESIGN.md §4; "
         "0 never splits); `tree-noorient` is the tree without the orientation terms of the "
-        "importance (`canopy render --no-orientation`).\n")
+        "importance (`canopy render --no-orientation`). On the glossy scenes (issue 11), "
+        "`bsdf` samples the BSDF only (no light sampling) and a trailing `/nomis` is the same "
+        "light sampler with multiple importance sampling off (`canopy render --no-mis`: light "
+        "sampling alone for direct light at non-delta vertices); without the suffix, light "
+        "and BSDF samples are combined with the power heuristic.\n")
 
     # ------------------------------------------------------------------ targets
     o.append("## Targets (issue 5)\n")
@@ -363,16 +484,23 @@ def main():
         "locate the best value between 0 and 0.5.\n"
         "* `tree-noorient` drops the orientation terms from the importance only (emitter cone "
         "and receiver cosine, Eq. 3); its tree is the same SAOH tree, so the ablation isolates "
-        "the importance measure as in the paper's Fig. 15-16, not the build heuristic.\n")
+        "the importance measure as in the paper's Fig. 15-16, not the build heuristic.\n"
+        "* The glossy scenes are stand-ins for Liu et al.'s (generated objects instead of their "
+        "armadillo, bunny and car; fewer lights than the car's 43,486), so their numbers are "
+        "not comparable with the paper's; they compare the samplers with each other on the same "
+        "scenes, which is what issue 12 needs.\n")
+
+    o.append(glossy_summary(glossy))
 
     # ------------------------------------------------------------------ scenes
-    for name, title in SCENES:
-        o.append(f"## {name}\n")
-        o.append(f"{title}: `scenes/{name}.json`.\n")
-        if name in scenes:
-            o.append(scene_section(scenes[name], a.clamp, a.seeds))
-        else:
-            o.append("Not run (the scene file was missing when the results were generated).\n")
+    for group, loaded, is_glossy in ((SCENES, scenes, False), (GLOSSY_SCENES, glossy, True)):
+        for name, title in group:
+            o.append(f"## {name}\n")
+            o.append(f"{title}: `scenes/{name}.json`.\n")
+            if name in loaded:
+                o.append(scene_section(loaded[name], a.clamp, a.seeds, a.docs, glossy=is_glossy))
+            else:
+                o.append("Not run (the scene file was missing when the results were generated).\n")
     print("\n".join(o))
 
 

@@ -127,6 +127,20 @@ canopy_cli_test(cli_max_cut_zero -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
 canopy_cli_test(cli_max_depth_too_large -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
   "-DARGS=--max-depth|1025" "-DEXPECT=--max-depth: must be in [1, 1024], got 1025"
   -P ${CANOPY_CHECK2})
+# Issue 11: MIS off. `canopy render --no-mis` says so on the summary line; `canopy converge
+# --samplers` takes a trailing /nomis (tests/cli_tools.cmake checks that it renders with MIS off),
+# refuses any other suffix and refuses /nomis on bsdf (BSDF sampling only), before rendering.
+canopy_cli_test(cli_render_no_mis
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--no-mis|--out|${CANOPY_SCRATCH}/no_mis.exr"
+  "-DSTDERR=sampler tree-split (threshold 0.25, max cut 64, no MIS)" -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_converge_bad_mis_suffix
+  "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|power,tree-split:0.5/mis"
+  -DRC=2 "-DSTDERR=--samplers: 'tree-split:0.5/mis': unknown suffix '/mis' (the only one is /nomis: MIS off)"
+  -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_converge_bsdf_nomis
+  "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|bsdf/nomis"
+  -DRC=2 "-DSTDERR=--samplers: 'bsdf/nomis': /nomis does not apply to bsdf (BSDF sampling only: there is no light sample to combine with)"
+  -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
 # NaN is refused by every floating-point option, of every subcommand.
 canopy_cli_test(cli_converge_budget_nan
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--budget|nan"

@@ -79,7 +79,8 @@ if(MODE STREQUAL "compare")
   expect_contains("${err}" "${DIR}/small.exr: size 4x4 differs from ${DIR}/a.exr (8x6)")
 elseif(MODE STREQUAL "converge")
   run_canopy(0 converge "${SCENE}" --reference "${DIR}/ref.exr" --reference-spp 64
-             --reference-sampler tree-split --samplers power,tree,tree-noorient,tree-split:0.5
+             --reference-sampler tree-split
+             --samplers power,tree,tree-noorient,tree-split:0.5,tree-split:0.5/nomis
              --budget 2
              --seeds 2 --out "${DIR}/tiny")
   foreach(f tiny.csv tiny-median.csv tiny-configs.csv tiny-time.png tiny-rays.png ref.exr)
@@ -92,6 +93,18 @@ elseif(MODE STREQUAL "converge")
   expect_contains("${header}" "sampler,light_sampler,split_threshold,spp,seed,seconds,shadow_rays")
   foreach(s ",power,power," ",tree,tree," ",tree-noorient,tree," ",tree-split:0.5,tree-split,0.5,")
     expect_contains("${rows}" "${s}")
+  endforeach()
+  # The mis column (last): /nomis renders with MIS off, every other configuration with MIS on.
+  file(STRINGS "${DIR}/tiny-configs.csv" cfg_rows)
+  foreach(re "^tiny_converge,tree-split:0.5/nomis,tree-split,0.5,.*,0$"
+             "^tiny_converge,tree-split:0.5,tree-split,0.5,.*,1$"
+             "^tiny_converge,power,power,.*,1$")
+    set(hits ${cfg_rows})
+    list(FILTER hits INCLUDE REGEX "${re}")
+    list(LENGTH hits n)
+    if(NOT n EQUAL 1)
+      message(FATAL_ERROR "tiny-configs.csv: expected one row matching ${re}:\n${cfg_rows}")
+    endif()
   endforeach()
   expect_contains("${out}" "equal-time RMSE")
   expect_contains("${err}" "light_sampler tree-split") # the reference's metadata, read back

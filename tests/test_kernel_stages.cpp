@@ -137,6 +137,8 @@ protected:
                                       i % 3 == 0 ? 0.0f : u(rng)));
       p.shade_N.push_back(f4_from3(normalize(make_float3(u(rng) - 0.5f, 1.0f, u(rng) - 0.5f)), 0));
       p.shade_f.push_back(make_float4(0, 0, 0, 0));
+      p.shade_wo.push_back(make_float4(0, 0, 0, 0));
+      p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
     }
     return p;
   }
@@ -159,7 +161,8 @@ protected:
   }
   SceneBuffers host_scene() {
     return SceneBuffers{geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
-                        geometry_.prims.data(), materials_.data()};
+                        geometry_.prims.data(), materials_.data(),
+                        geometry_.shading_normals.data()};
   }
 
   ClRuntime rt_;
@@ -184,6 +187,8 @@ void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& w
     expect_close(dev.shade_N[p].x, ref.shade_N[p].x, at + " N");
     EXPECT_EQ(float_as_uint_(dev.shade_N[p].w), float_as_uint_(ref.shade_N[p].w)) << at << " seed";
     expect_close4(dev.shade_f[p], ref.shade_f[p], at + " shade_f");
+    expect_close4(dev.shade_wo[p], ref.shade_wo[p], at + " shade_wo");
+    expect_close4(dev.shade_Ns[p], ref.shade_Ns[p], at + " shade_Ns");
     if (::testing::Test::HasFailure()) return; // one path's report is enough
   }
 }

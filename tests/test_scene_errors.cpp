@@ -234,6 +234,11 @@ TEST(SceneErrors, MaxCutOutOfRange) {
             "scene.json: integrator.max_cut: must be an integer");
 }
 
+TEST(SceneErrors, MisNotABool) {
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"mis": 0})")),
+            "scene.json: integrator.mis: must be true or false");
+}
+
 TEST(SceneErrors, SeedNegative) {
   EXPECT_EQ(error_of(scene_with(R"("integrator": {"seed": -1})")),
             "scene.json: integrator.seed: must be in [0, 4294967295]");
@@ -264,7 +269,107 @@ TEST(SceneErrors, DuplicateMaterialName) {
 
 TEST(SceneErrors, UnknownMaterialType) {
   EXPECT_EQ(error_of(scene_with(R"("materials": [{"name": "m", "type": "glass", "albedo": 1}])")),
-            "scene.json: materials[0].type: unknown value \"glass\" (expected one of: diffuse)");
+            "scene.json: materials[0].type: unknown value \"glass\" (expected one of: diffuse, "
+            "conductor, plastic)");
+}
+
+namespace {
+std::string material_error(const std::string& material) {
+  return error_of(scene_with(R"("materials": [{"name": "ok", "albedo": 0.5}, )" + material + "]"));
+}
+} // namespace
+
+TEST(SceneErrors, KeyOfAnotherMaterialType) {
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.1,
+      "metal": "gold", "albedo": 0.5})"),
+            "scene.json: materials[1].albedo: unknown key");
+  EXPECT_EQ(material_error(R"({"name": "m", "roughness": 0.1, "albedo": 0.5})"),
+            "scene.json: materials[1].roughness: unknown key"); // diffuse by default
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "roughness": 0.1,
+      "albedo": 0.5, "metal": "gold"})"),
+            "scene.json: materials[1].metal: unknown key");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "roughness": 0.1,
+      "albedo": 0.5, "k": 1})"),
+            "scene.json: materials[1].k: unknown key");
+}
+
+TEST(SceneErrors, MaterialRoughness) {
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "metal": "gold"})"),
+            "scene.json: materials[1].roughness: required key is missing");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "albedo": 0.5})"),
+            "scene.json: materials[1].roughness: required key is missing");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "metal": "gold",
+      "roughness": 1.01})"),
+            "scene.json: materials[1].roughness: must be in [0, 1]");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "albedo": 0.5,
+      "roughness": -0.5})"),
+            "scene.json: materials[1].roughness: must be in [0, 1]");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "albedo": 0.5,
+      "roughness": [0.5]})"),
+            "scene.json: materials[1].roughness: must be a number");
+}
+
+TEST(SceneErrors, ConductorMetalOrEtaK) {
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2})"),
+            "scene.json: materials[1]: a conductor needs \"metal\" (a preset name) or \"eta\" "
+            "and \"k\"");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "metal": "gold", "eta": 1})"),
+            "scene.json: materials[1].eta: not allowed together with \"metal\" (give a preset "
+            "or eta and k)");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "k": 1, "metal": "gold"})"),
+            "scene.json: materials[1].k: not allowed together with \"metal\" (give a preset or "
+            "eta and k)");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2, "eta": 1})"),
+            "scene.json: materials[1].k: required key is missing");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2, "k": 1})"),
+            "scene.json: materials[1].eta: required key is missing");
+}
+
+TEST(SceneErrors, UnknownMetalListsThePresets) {
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "metal": "Gold"})"),
+            "scene.json: materials[1].metal: unknown value \"Gold\" (expected one of: gold, "
+            "silver, copper, aluminium, chromium, iron, nickel, titanium)");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "metal": 3})"),
+            "scene.json: materials[1].metal: must be a string");
+}
+
+TEST(SceneErrors, ConductorEtaKRange) {
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "eta": 0, "k": 1})"),
+            "scene.json: materials[1].eta: must be in [0.01, 1000]");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "eta": [1, 1, 0.001], "k": 1})"),
+            "scene.json: materials[1].eta[2]: must be in [0.01, 1000]");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "eta": 1, "k": [-0.5, 1, 1]})"),
+            "scene.json: materials[1].k[0]: must be in [0, 1000]");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "eta": 1, "k": 1e5})"),
+            "scene.json: materials[1].k: must be in [0, 1000]");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "conductor", "roughness": 0.2,
+      "eta": [1, 1], "k": 1})"),
+            "scene.json: materials[1].eta: must be a number or an array of 3 numbers");
+}
+
+TEST(SceneErrors, PlasticRanges) {
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "roughness": 0.2,
+      "albedo": [0.5, 1.5, 0]})"),
+            "scene.json: materials[1].albedo[1]: must be in [0, 1]");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "roughness": 0.2})"),
+            "scene.json: materials[1].albedo: required key is missing");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "roughness": 0.2,
+      "albedo": 0.5, "specular": [1, -1, 1]})"),
+            "scene.json: materials[1].specular[1]: must be >= 0");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "roughness": 0.2,
+      "albedo": 0.5, "ior": 0.9})"),
+            "scene.json: materials[1].ior: must be in [1, 10]");
+  EXPECT_EQ(material_error(R"({"name": "m", "type": "plastic", "roughness": 0.2,
+      "albedo": 0.5, "ior": 11})"),
+            "scene.json: materials[1].ior: must be in [1, 10]");
 }
 
 TEST(SceneErrors, UnknownMaterialReference) {
@@ -422,6 +527,51 @@ TEST(SceneErrors, MtlKdAboveOne) {
 TEST(SceneErrors, MtlKeNegative) {
   EXPECT_EQ(error_of(scene_with(R"("shapes": [{"type": "obj", "file": "bad_ke.obj"}])")),
             "scene.json: shapes[0].file: bad_ke.obj: material 'negative': Ke must be >= 0");
+}
+
+namespace {
+// The error of an OBJ triangle whose material is `mtl` (the body of an MTL "newmtl m").
+std::string mtl_error(const std::string& mtl) {
+  std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "canopy_mtl_mapping";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream(dir / "m.obj") << "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
+  }
+  { std::ofstream(dir / "m.mtl") << "newmtl m\n" << mtl; }
+  try {
+    load_scene_from_string(scene_with(R"("shapes": [{"type": "obj", "file": "m.obj"}])"),
+                           "scene.json", dir);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+} // namespace
+
+TEST(SceneErrors, MtlGlossyValues) {
+  EXPECT_EQ(mtl_error("Kd 0.5 0.5 0.5\nKs 0.5 -0.1 0.5\nillum 2\n"),
+            "scene.json: shapes[0].file: m.obj: material 'm': Ks must be >= 0");
+  EXPECT_EQ(mtl_error("Kd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs -1\nillum 2\n"),
+            "scene.json: shapes[0].file: m.obj: material 'm': Ns must be >= 0");
+  EXPECT_EQ(mtl_error("Kd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs 10\nNi 12\nillum 2\n"),
+            "scene.json: shapes[0].file: m.obj: material 'm': Ni must be <= 10");
+  // Ns and Ni matter only for a glossy material: a diffuse one ignores them.
+  EXPECT_EQ(mtl_error("Kd 0.5 0.5 0.5\nKs 0 0 0\nNs -1\nNi 12\nillum 2\n"), "(no error)");
+  EXPECT_EQ(mtl_error("Kd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs -1\nNi 12\nillum 1\n"), "(no error)");
+}
+
+TEST(SceneErrors, ObjNormalIndexOutOfRange) {
+  std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "canopy_vn_range";
+  std::filesystem::create_directories(dir);
+  { std::ofstream(dir / "n.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n"; }
+  std::string m;
+  try {
+    load_scene_from_string(scene_with(R"("shapes": [{"type": "obj", "file": "n.obj"}])"),
+                           "scene.json", dir);
+  } catch (const SceneError& e) {
+    m = e.what();
+  }
+  EXPECT_EQ(m, "scene.json: shapes[0].file: n.obj: face 1 of '' has a normal index out of range");
 }
 
 TEST(SceneErrors, ObjIndexOutOfRange) {

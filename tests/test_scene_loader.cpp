@@ -1,7 +1,9 @@
 // Good scenes: every value lands where docs/scene-format.md says it does.
+#include "scene/metal_presets.h"
 #include "test_scene_util.h"
 
 #include <cmath>
+#include <set>
 
 using namespace canopy;
 using namespace canopy::test;
@@ -29,7 +31,7 @@ TEST(SceneLoader, CameraFilmIntegrator) {
     "camera": {"position": [1, 2, 3], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov": 60},
     "film": {"width": 320, "height": 200},
     "integrator": {"spp": 7, "max_depth": 4, "light_sampler": "tree-split",
-                   "split_threshold": 0.5, "max_cut": 9, "seed": 4294967295},
+                   "split_threshold": 0.5, "max_cut": 9, "seed": 4294967295, "mis": false},
     "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}]
   })");
   EXPECT_FLOAT_EQ(s.camera.position.x, 1);
@@ -45,6 +47,7 @@ TEST(SceneLoader, CameraFilmIntegrator) {
   EXPECT_FLOAT_EQ(s.integrator.split_threshold, 0.5f);
   EXPECT_EQ(s.integrator.max_cut, 9);
   EXPECT_EQ(s.integrator.seed, 4294967295u);
+  EXPECT_FALSE(s.integrator.mis);
   EXPECT_EQ(s.path, "scene.json");
 }
 
@@ -61,6 +64,7 @@ TEST(SceneLoader, Defaults) {
   EXPECT_FLOAT_EQ(s.integrator.split_threshold, LT_DEFAULT_SPLIT_THRESHOLD);
   EXPECT_EQ(s.integrator.max_cut, 64);
   EXPECT_EQ(s.integrator.seed, 1u);
+  EXPECT_TRUE(s.integrator.mis);
   ASSERT_EQ(s.materials.size(), 1u);
   EXPECT_EQ(s.materials[0].name, "default");
   EXPECT_FLOAT_EQ(s.materials[0].gpu.albedo.x, 0.8f);
@@ -91,6 +95,126 @@ TEST(SceneLoader, Materials) {
   EXPECT_FLOAT_EQ(s.materials[1].gpu.albedo.y, 0.1f);
   EXPECT_EQ(s.materials[1].gpu.type, MATERIAL_DIFFUSE);
   EXPECT_FLOAT_EQ(s.materials[2].gpu.albedo.z, 0.25f);
+}
+
+TEST(SceneLoader, ConductorWithEtaAndK) {
+  Scene s = load_str(scene_with(R"("materials": [
+      {"name": "c", "type": "conductor", "roughness": 0.3, "eta": [0.2, 0.5, 1.5],
+       "k": [3.5, 2.5, 1.75]},
+      {"name": "mirror", "type": "conductor", "roughness": 0, "eta": 1, "k": 0}])"));
+  ASSERT_EQ(s.materials.size(), 3u);
+  const Material& m = s.materials[1].gpu;
+  EXPECT_EQ(s.materials[1].name, "c");
+  EXPECT_EQ(m.type, MATERIAL_CONDUCTOR);
+  EXPECT_FLOAT_EQ(m.alpha, 0.3f * 0.3f); // alpha = roughness^2
+  EXPECT_FLOAT_EQ(m.specular.x, 0.2f);   // eta lives in `specular`
+  EXPECT_FLOAT_EQ(m.specular.y, 0.5f);
+  EXPECT_FLOAT_EQ(m.specular.z, 1.5f);
+  EXPECT_FLOAT_EQ(m.k.x, 3.5f);
+  EXPECT_FLOAT_EQ(m.k.y, 2.5f);
+  EXPECT_FLOAT_EQ(m.k.z, 1.75f);
+  const Material& mirror = s.materials[2].gpu;
+  EXPECT_EQ(mirror.alpha, 0.0f); // a perfect mirror
+  EXPECT_FLOAT_EQ(mirror.specular.z, 1.0f);
+  EXPECT_EQ(mirror.k.y, 0.0f);
+}
+
+TEST(SceneLoader, ConductorPresets) {
+  // Every preset loads by name and gives exactly the table's eta and k.
+  std::string mats;
+  for (const MetalPreset& p : metal_presets())
+    mats += std::string(mats.empty() ? "" : ", ") + R"({"name": ")" + std::string(p.name) +
+            R"(", "type": "conductor", "roughness": 0.5, "metal": ")" + std::string(p.name) +
+            R"("})";
+  Scene s = load_str(scene_with("\"materials\": [" + mats + "]"));
+  ASSERT_EQ(s.materials.size(), 1 + kMetalPresetCount);
+  for (size_t i = 0; i < kMetalPresetCount; ++i) {
+    const MetalPreset& p = metal_presets()[i];
+    const Material& m = s.materials[i + 1].gpu;
+    SCOPED_TRACE(std::string(p.name));
+    EXPECT_EQ(m.type, MATERIAL_CONDUCTOR);
+    EXPECT_FLOAT_EQ(m.alpha, 0.25f);
+    EXPECT_EQ(m.specular.x, p.eta[0]);
+    EXPECT_EQ(m.specular.y, p.eta[1]);
+    EXPECT_EQ(m.specular.z, p.eta[2]);
+    EXPECT_EQ(m.k.x, p.k[0]);
+    EXPECT_EQ(m.k.y, p.k[1]);
+    EXPECT_EQ(m.k.z, p.k[2]);
+  }
+  // Spot values against scripts/metal-presets.py (Johnson & Christy 1972 at 650/550/450 nm).
+  const MetalPreset* gold = find_metal_preset("gold");
+  ASSERT_NE(gold, nullptr);
+  EXPECT_FLOAT_EQ(gold->eta[1], 0.424f);
+  EXPECT_FLOAT_EQ(gold->k[0], 3.602f);
+  EXPECT_EQ(find_metal_preset("unobtainium"), nullptr);
+}
+
+namespace {
+// Normal-incidence reflectance of a conductor, ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2).
+double f0(double n, double k) {
+  return ((n - 1) * (n - 1) + k * k) / ((n + 1) * (n + 1) + k * k);
+}
+} // namespace
+
+TEST(SceneLoader, ConductorPresetsLookLikeTheirMetals) {
+  // The presets are measured data; these are properties every correct table has (a swapped
+  // channel, eta/k mix-up or typo breaks one): gold and copper reflect red far more than blue,
+  // silver and aluminium are bright and nearly neutral, and every value is inside the range the
+  // scene format accepts for "eta" and "k".
+  std::set<std::string_view> names;
+  for (const MetalPreset& p : metal_presets()) {
+    SCOPED_TRACE(std::string(p.name));
+    EXPECT_TRUE(names.insert(p.name).second);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_GE(p.eta[c], kMinConductorEta);
+      EXPECT_LE(p.eta[c], kMaxConductorIndex);
+      EXPECT_GE(p.k[c], 0.0f);
+      EXPECT_LE(p.k[c], kMaxConductorIndex);
+      EXPECT_GT(f0(p.eta[c], p.k[c]), 0.4); // every metal here reflects > 40% at normal incidence
+    }
+  }
+  auto r = [](const char* name, int c) {
+    const MetalPreset* p = find_metal_preset(name);
+    return f0(p->eta[c], p->k[c]);
+  };
+  EXPECT_GT(r("gold", 0), r("gold", 1));
+  EXPECT_GT(r("gold", 1), r("gold", 2) + 0.2);
+  EXPECT_GT(r("copper", 0), r("copper", 1) + 0.2);
+  EXPECT_GT(r("copper", 1), r("copper", 2));
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GT(r("silver", c), 0.95);
+    EXPECT_GT(r("aluminium", c), 0.88);
+    EXPECT_LT(r("aluminium", c), 0.95);
+  }
+}
+
+TEST(SceneLoader, Plastic) {
+  Scene s = load_str(scene_with(R"("materials": [
+      {"name": "p", "type": "plastic", "albedo": [0.8, 0.1, 0.2], "roughness": 0.1},
+      {"name": "q", "type": "plastic", "albedo": 0.5, "specular": [0.5, 2, 0], "roughness": 1,
+       "ior": 2.4},
+      {"name": "default", "type": "plastic", "albedo": 0.3, "roughness": 0, "ior": 1}])"));
+  ASSERT_EQ(s.materials.size(), 3u);
+  const Material& p = s.materials[1].gpu;
+  EXPECT_EQ(p.type, MATERIAL_PLASTIC);
+  EXPECT_FLOAT_EQ(p.albedo.x, 0.8f);
+  EXPECT_FLOAT_EQ(p.albedo.z, 0.2f);
+  EXPECT_EQ(p.specular.x, 1.0f); // default specular 1
+  EXPECT_EQ(p.specular.y, 1.0f);
+  EXPECT_EQ(p.specular.z, 1.0f);
+  EXPECT_FLOAT_EQ(p.alpha, 0.1f * 0.1f);
+  EXPECT_EQ(p.ior, 1.5f); // default ior
+  const Material& q = s.materials[2].gpu;
+  EXPECT_FLOAT_EQ(q.specular.x, 0.5f);
+  EXPECT_FLOAT_EQ(q.specular.y, 2.0f);
+  EXPECT_EQ(q.specular.z, 0.0f);
+  EXPECT_EQ(q.alpha, 1.0f);
+  EXPECT_FLOAT_EQ(q.ior, 2.4f);
+  // The built-in default may be replaced by a glossy material.
+  EXPECT_EQ(s.materials[0].name, "default");
+  EXPECT_EQ(s.materials[0].gpu.type, MATERIAL_PLASTIC);
+  EXPECT_EQ(s.materials[0].gpu.alpha, 0.0f);
+  EXPECT_EQ(s.materials[0].gpu.ior, 1.0f);
 }
 
 TEST(SceneLoader, PointAndSpot) {
@@ -279,6 +403,59 @@ TEST(SceneLoader, ObjMaterialOverrideAndSceneEmission) {
   EXPECT_EQ(s.triangle_light[7], 4); // the floor triangle of the second OBJ
   EXPECT_FLOAT_EQ(s.lights.back().emission.y, 2.0f);
   EXPECT_EQ(s.triangle_light[9], 6);
+}
+
+TEST(SceneLoader, MtlMapping) {
+  // tests/data/glossy.mtl: one material per case, one triangle each, in order.
+  Scene s = load_str(scene_with(R"("shapes": [{"type": "obj", "file": "glossy.obj"}])"));
+  ASSERT_EQ(s.triangle_count(), 6u);
+  auto mat = [&](size_t t) -> const MaterialDesc& {
+    return s.materials[size_t(s.triangle_material[t])];
+  };
+  // Roughness from Ns: alpha = sqrt(2 / (Ns + 2)) (Walter et al. 2007, eq. 33), r = sqrt(alpha).
+  auto alpha_of_ns = [](double ns) { return std::sqrt(2.0 / (ns + 2.0)); };
+
+  // illum 1: diffuse Kd, Ks ignored.
+  EXPECT_EQ(mat(0).name, "matte_illum1");
+  EXPECT_EQ(mat(0).gpu.type, MATERIAL_DIFFUSE);
+  EXPECT_FLOAT_EQ(mat(0).gpu.albedo.x, 0.5f);
+  // illum 2 with Ks = 0: diffuse.
+  EXPECT_EQ(mat(1).gpu.type, MATERIAL_DIFFUSE);
+  EXPECT_FLOAT_EQ(mat(1).gpu.albedo.z, 0.4f);
+  // illum 2, Ks > 0: plastic with albedo Kd, specular Ks, roughness of Ns, ior Ni.
+  const Material& shiny = mat(2).gpu;
+  EXPECT_EQ(mat(2).name, "shiny");
+  EXPECT_EQ(shiny.type, MATERIAL_PLASTIC);
+  EXPECT_FLOAT_EQ(shiny.albedo.y, 0.2f);
+  EXPECT_FLOAT_EQ(shiny.specular.x, 0.04f);
+  EXPECT_FLOAT_EQ(shiny.specular.z, 0.06f);
+  EXPECT_NEAR(shiny.alpha, alpha_of_ns(98), 1e-6);
+  EXPECT_NEAR(shiny.alpha, 0.1414214, 1e-6); // sqrt(2/100)
+  EXPECT_FLOAT_EQ(shiny.ior, 1.45f);
+  // Ns 0: roughness 1; no Ni: ior 1.5.
+  const Material& rough = mat(3).gpu;
+  EXPECT_EQ(rough.type, MATERIAL_PLASTIC);
+  EXPECT_NEAR(rough.alpha, 1.0, 1e-6);
+  EXPECT_EQ(rough.ior, 1.5f);
+  EXPECT_FLOAT_EQ(rough.specular.y, 1.0f);
+  // illum 3 is plastic too; Ni 1 (MTL's "unset") gives 1.5.
+  const Material& mirror = mat(4).gpu;
+  EXPECT_EQ(mirror.type, MATERIAL_PLASTIC);
+  EXPECT_NEAR(mirror.alpha, alpha_of_ns(1000), 1e-6);
+  EXPECT_EQ(mirror.ior, 1.5f);
+  EXPECT_EQ(mirror.albedo.x, 0.0f);
+  // No illum line (illum 0): diffuse even with Ks.
+  EXPECT_EQ(mat(5).gpu.type, MATERIAL_DIFFUSE);
+  EXPECT_FLOAT_EQ(mat(5).gpu.albedo.x, 0.7f);
+}
+
+TEST(SceneLoader, SceneMaterialReplacesMtlMaterial) {
+  // A scene material named like an MTL material wins, of any type: how a scene makes an OBJ's
+  // material a metal.
+  Scene s = load_str(scene_with(R"("materials": [{"name": "mirror_like", "type": "conductor",
+      "roughness": 0, "metal": "silver"}], "shapes": [{"type": "obj", "file": "glossy.obj"}])"));
+  EXPECT_EQ(s.triangle_material[4], 1);
+  EXPECT_EQ(s.materials[1].gpu.type, MATERIAL_CONDUCTOR);
 }
 
 TEST(SceneLoader, SceneFileRelativePaths) {

@@ -7,6 +7,7 @@
 #ifndef CANOPY_INTEGRATOR_LIGHT_PICK_H
 #define CANOPY_INTEGRATOR_LIGHT_PICK_H
 
+#include "../bsdf/bsdf.h"
 #include "../light_sample.h"
 #include "../shading.h"
 #include "light_sampler.h"
@@ -20,19 +21,25 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   float3 P = xyz_of(pb->shade_P[path]);
   float3 N = xyz_of(pb->shade_N[path]);
   float4 f = pb->shade_f[path];
+  float4 wo_m = pb->shade_wo[path];
   float u1 = lt_rng_next(rng);
   float u2 = lt_rng_next(rng);
   LightSample s = sample_light(&ls->lights[light], P, u1, u2);
-  float cos_n = dot(N, s.wi);
-  if (!(s.pdf > 0.0f) || !(cos_n > 0.0f) || !(max3(s.Li) > 0.0f) || !(pmf > 0.0f)) return 0;
+  // Light arriving from below the geometric surface would leak through it (shading normals).
+  if (!(s.pdf > 0.0f) || !(dot(N, s.wi) > 0.0f) || !(max3(s.Li) > 0.0f) || !(pmf > 0.0f)) return 0;
+  Material m = sc->materials[(int)float_as_uint_(wo_m.w)];
+  Frame fr = frame_from(xyz_of(pb->shade_Ns[path]));
+  float3 wo = frame_to_local(&fr, xyz_of(wo_m));
+  float3 wi = frame_to_local(&fr, s.wi);
+  if (!(wi.z > 0.0f)) return 0;
+  float3 bsdf = bsdf_eval(&m, wo, wi);
   // MIS against BSDF sampling when the path continues with it (never for delta lights).
   float w = 1.0f;
-  if (!s.is_delta && f.w > 0.0f) w = power_heuristic(pmf * s.pdf, cos_n * CANOPY_INV_PI);
-  float3 c = xyz_of(f) * s.Li * (cos_n * w / (s.pdf * pmf));
+  if (!s.is_delta && f.w > 0.0f) w = power_heuristic(pmf * s.pdf, bsdf_pdf(&m, wo, wi));
+  float3 c = xyz_of(f) * bsdf * s.Li * (wi.z * w / (s.pdf * pmf));
   // A non-finite contribution is kept, not dropped: it reaches the path's radiance, where
   // accumulate counts the sample as non-finite (reported by --stats) and records it as zero.
   if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) return 0;
-  (void)sc;
   // P is already off the surface (shade_surface). The ray ends short of the light point by the
   // float error of that point's own coordinates and of the distance, not by a scene-wide margin;
   // an area light's point is already off the light's surface (sample_light).

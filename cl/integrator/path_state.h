@@ -19,20 +19,26 @@
   X(Hit, hits)          /* closest hit of the current ray */                                       \
   /* The last shading point, kept for light picking in this bounce and for MIS at the next hit. */ \
   /* xyz: position (the ray origin of rays leaving it, offset from the surface, cl/shading.h), */  \
-  /* w: solid-angle pdf of the BSDF direction that left it */                                      \
+  /* w: solid-angle pdf of the BSDF direction that left it (0: delta) */                                  \
   X(float4, shade_P)                                                                               \
-  /* xyz: normal facing the incoming ray, w: light-pick seed (uint bits) */                        \
+  /* xyz: geometric normal facing wo, w: light-pick seed (uint bits) */                           \
   X(float4, shade_N)                                                                               \
-  /* xyz: beta * BSDF value (diffuse: albedo/pi), w: 1 if BSDF sampling continues the path */      \
-  /* (MIS on), 0 at the last vertex (light sampling alone) */                                      \
-  X(float4, shade_f)
+  /* xyz: path throughput beta at the shading point, w: 1 if light samples are MIS-weighted */     \
+  /* against BSDF sampling (the path continues with a BSDF sample and MIS is on), else 0 */        \
+  X(float4, shade_f)                                                                               \
+  /* xyz: unit direction towards the viewer, w: material index (int bits) */                       \
+  X(float4, shade_wo)                                                                              \
+  /* xyz: shading normal (on wo's side; the geometric normal when flat) */                         \
+  X(float4, shade_Ns)
 
 // The scene's buffers, likewise: X(element type, name), read-only on the device.
 #define SCENE_BUFFERS(X)                                                                           \
   X(BvhNode, nodes)                                                                                \
   X(int, prim_index)                                                                               \
   X(Primitive, prims)                                                                              \
-  X(Material, materials)
+  X(Material, materials)                                                                           \
+  /* three unit vertex normals per smooth triangle (Primitive.normals, cl/geometry.h) */            \
+  X(float4, shading_normals)
 // clang-format on
 
 #define CANOPY_PATH_FIELD(T, name) GLOBAL T* name;

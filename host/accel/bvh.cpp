@@ -20,6 +20,7 @@ Primitive make_triangle(float3 a, float3 b, float3 c, int material, int light) {
   p.type = PRIM_TRIANGLE;
   p.material = material;
   p.light = light;
+  p.normals = -1;
   return p;
 }
 
@@ -160,6 +161,7 @@ std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& mat
     const float3 c = scene.vertices[scene.indices[3 * t + 2]];
     int light = scene.triangle_light.empty() ? -1 : scene.triangle_light[t];
     prims.push_back(make_triangle(a, b, c, scene.triangle_material[t], light));
+    if (!scene.triangle_normals.empty()) prims.back().normals = scene.triangle_normals[t];
     if (light >= 0) scene.lights[light].prim = int(t);
   }
   // Light shapes are black: they emit, they do not reflect.
@@ -178,6 +180,7 @@ std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& mat
       s.type = PRIM_SPHERE;
       s.material = black;
       s.light = int(i);
+      s.normals = -1;
       l.prim = int(prims.size());
       prims.push_back(s);
     } else if (l.type == LIGHT_QUAD) {
@@ -263,6 +266,9 @@ Bvh build_bvh(const std::vector<Primitive>& prims) {
 SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& materials) {
   SceneGeometry g;
   g.prims = build_primitives(scene, materials);
+  g.shading_normals.reserve(scene.shading_normals.size());
+  for (const float3& n : scene.shading_normals)
+    g.shading_normals.push_back(f4_from3(n, 0.0f));
   g.bvh = build_bvh(g.prims);
   float3 lo = make_float3(0, 0, 0), hi = lo;
   bool any = false;

@@ -20,6 +20,10 @@ struct Bvh {
 
 struct SceneGeometry {
   std::vector<Primitive> prims;
+  // Shading normals of the smooth triangles (Scene::shading_normals as float4, w = 0): a
+  // triangle's Primitive::normals indexes its first of three (cl/geometry.h
+  // primitive_shading_normal). Empty when every triangle is flat.
+  std::vector<float4> shading_normals;
   Bvh bvh;
   float3 bounds_min{0, 0, 0}, bounds_max{0, 0, 0};
 };
@@ -27,6 +31,8 @@ struct SceneGeometry {
 // Primitives for every scene triangle and every sphere/quad/triangle light (a quad is two
 // triangles). Sets Light::prim of each light that has a shape (mesh-light triangles point at their
 // own triangle). Analytic light shapes use an extra black material appended to the list.
+// Primitive::normals of a scene triangle is Scene::triangle_normals[t] (an index into
+// Scene::shading_normals), -1 for flat triangles and light shapes.
 std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& materials);
 
 // 4-wide SAH BVH over `prims`, via rtcBuildBVH; depth limited (BVH_MAX_DEPTH) so the kernels'

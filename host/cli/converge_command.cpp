@@ -46,14 +46,18 @@ struct ConvergeArgs {
 };
 
 // One sampler configuration: "tree-split:0.5" = light sampler tree-split, threshold 0.5;
-// "tree-noorient" = tree without Eq. 3's orientation terms (importance E / d^2: the ablation).
+// "tree-noorient" = tree without Eq. 3's orientation terms (importance E / d^2: the ablation);
+// a trailing "/nomis" (e.g. "power/nomis", "tree-split:0.25/nomis") switches MIS off. Without it
+// MIS is on, whatever the scene's integrator says, so that a label names one configuration.
 struct SamplerConfig {
   std::string label, sampler;
   float threshold = 0.0f;
   bool orientation = true;
+  bool mis = true;
 };
 
 constexpr std::string_view kNoOrientSuffix = "-noorient";
+constexpr std::string_view kNoMisSuffix = "nomis"; // after a '/'
 
 struct RunRecord {
   int spp = 0;
@@ -85,8 +89,18 @@ SamplerConfig parse_config(const std::string& text, float default_threshold,
                            const std::string& option) {
   SamplerConfig c;
   c.label = text;
-  size_t colon = text.find(':');
-  c.sampler = text.substr(0, colon);
+  std::string spec = text;
+  if (size_t slash = spec.find('/'); slash != std::string::npos) {
+    std::string suffix = spec.substr(slash + 1);
+    if (suffix != kNoMisSuffix)
+      throw SceneError(fmt::format("{}: '{}': unknown suffix '/{}' (the only one is /{}: MIS off)",
+                                   option, printable(text, 256), printable(suffix, 256),
+                                   kNoMisSuffix));
+    spec.resize(slash);
+    c.mis = false;
+  }
+  size_t colon = spec.find(':');
+  c.sampler = spec.substr(0, colon);
   c.threshold = default_threshold;
   if (c.sampler.size() > kNoOrientSuffix.size() && c.sampler.ends_with(kNoOrientSuffix)) {
     c.sampler.resize(c.sampler.size() - kNoOrientSuffix.size());
@@ -95,13 +109,17 @@ SamplerConfig parse_config(const std::string& text, float default_threshold,
       throw SceneError(
           fmt::format("{}: '{}': {} applies to tree samplers only", option, text, kNoOrientSuffix));
   }
+  if (!c.mis && c.sampler == "bsdf")
+    throw SceneError(fmt::format("{}: '{}': /{} does not apply to bsdf (BSDF sampling only: "
+                                 "there is no light sample to combine with)",
+                                 option, printable(text, 256), kNoMisSuffix));
   if (std::find(kLightSamplerNames.begin(), kLightSamplerNames.end(), c.sampler) ==
       kLightSamplerNames.end())
     throw SceneError(fmt::format("{}: unknown light sampler '{}' (one of {}; tree samplers take "
-                                 "-noorient)",
+                                 "-noorient; /nomis switches MIS off)",
                                  option, c.sampler, fmt::join(kLightSamplerNames, ", ")));
   if (colon != std::string::npos) {
-    std::string t = text.substr(colon + 1);
+    std::string t = spec.substr(colon + 1);
     char* end = nullptr;
     double v = std::strtod(t.c_str(), &end);
     if (t.empty() || *end != '\0' || !(v >= 0.0 && v <= 1.0))
@@ -231,6 +249,7 @@ void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, P
   opt.split_threshold = c.threshold;
   opt.max_cut = base.integrator.max_cut;
   opt.orientation_term = c.orientation;
+  opt.mis = c.mis;
   Renderer r(rt, scene, opt);
   const int half_spp = std::max(1, a.reference_spp / 2);
   auto t0 = Clock::now();
@@ -261,6 +280,7 @@ void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, P
              {"canopy:light_sampler", c.sampler},
              {"canopy:split_threshold", fmt::format("{}", c.threshold)},
              {"canopy:orientation_term", c.orientation ? "on" : "off"},
+             {"canopy:mis", c.mis ? "on" : "off"},
              {"canopy:spp", std::to_string(2 * half_spp)},
              {"canopy:seed",
               fmt::format("{} (spp/2) + {} (spp/2)", a.reference_seed, a.reference_seed + 1)},
@@ -279,13 +299,13 @@ void write_csvs(const fs::path& prefix, const std::string& scene, double ref_mse
                 const std::vector<ConfigResult>& results) {
   std::ofstream runs = open_out(prefix.string() + ".csv");
   runs << "scene,sampler,light_sampler,split_threshold,spp,seed,seconds,shadow_rays,shading_points,"
-          "rmse,relmse,psnr,reference_mse,clamp\n";
+          "rmse,relmse,psnr,reference_mse,clamp,mis\n";
   for (const ConfigResult& r : results)
     for (const RunRecord& x : r.runs)
-      runs << fmt::format("{},{},{},{},{},{},{:.6f},{},{},{:.6e},{:.6e},{:.4f},{:.6e},{}\n", scene,
-                          r.config.label, r.config.sampler, r.config.threshold, x.spp, x.seed,
-                          x.seconds, x.shadow_rays, x.shading_points, x.metrics.rmse,
-                          x.metrics.relmse, x.metrics.psnr, ref_mse, clamp);
+      runs << fmt::format("{},{},{},{},{},{},{:.6f},{},{},{:.6e},{:.6e},{:.4f},{:.6e},{},{}\n",
+                          scene, r.config.label, r.config.sampler, r.config.threshold, x.spp,
+                          x.seed, x.seconds, x.shadow_rays, x.shading_points, x.metrics.rmse,
+                          x.metrics.relmse, x.metrics.psnr, ref_mse, clamp, int(r.config.mis));
   std::ofstream med = open_out(prefix.string() + "-median.csv");
   med << "scene,sampler,spp,runs,seconds,shadow_rays,rmse,relmse\n";
   for (const ConfigResult& r : results)
@@ -297,12 +317,13 @@ void write_csvs(const fs::path& prefix, const std::string& scene, double ref_mse
     }
   std::ofstream cfg = open_out(prefix.string() + "-configs.csv");
   cfg << "scene,sampler,light_sampler,split_threshold,build_seconds,light_tree_seconds,"
-         "compile_seconds,warmup_seconds,render_seconds,runs,max_spp\n";
+         "compile_seconds,warmup_seconds,render_seconds,runs,max_spp,mis\n";
   for (const ConfigResult& r : results)
-    cfg << fmt::format("{},{},{},{},{:.4f},{:.4f},{:.4f},{:.3f},{:.3f},{},{}\n", scene,
+    cfg << fmt::format("{},{},{},{},{:.4f},{:.4f},{:.4f},{:.3f},{:.3f},{},{},{}\n", scene,
                        r.config.label, r.config.sampler, r.config.threshold, r.build_seconds,
                        r.light_tree_seconds, r.compile_seconds, r.warmup_seconds, r.render_seconds,
-                       r.runs.size(), r.medians.empty() ? 0 : r.medians.back().spp);
+                       r.runs.size(), r.medians.empty() ? 0 : r.medians.back().spp,
+                       int(r.config.mis));
 }
 
 int run_converge(const ConvergeArgs& a) {
@@ -361,6 +382,7 @@ int run_converge(const ConvergeArgs& a) {
     opt.split_threshold = res.config.threshold;
     opt.max_cut = base.integrator.max_cut;
     opt.orientation_term = res.config.orientation;
+    opt.mis = res.config.mis;
     renderers.push_back(std::make_unique<Renderer>(rt, *scenes.back(), opt));
     Renderer& renderer = *renderers.back();
     res.build_seconds = renderer.stats().build_seconds;
@@ -503,9 +525,11 @@ CLI::App* add_converge_command(CLI::App& app, std::function<int()>& action) {
                   "Reference EXR (made with --reference-spp, or by `canopy render`)")
       ->required();
   cmd->add_option("--samplers", a->samplers,
-                  "Comma-separated configurations: uniform, power, tree, tree-split, exhaustive; "
-                  "tree-split:T sets the split threshold T; tree-noorient and "
-                  "tree-split-noorient[:T] drop the orientation terms of the importance")
+                  "Comma-separated configurations: a light sampler (uniform, power, tree, "
+                  "tree-split, exhaustive, ...); tree-split:T sets the split threshold T; "
+                  "tree-noorient and tree-split-noorient[:T] drop the orientation terms of the "
+                  "importance; a trailing /nomis switches MIS off (e.g. power/nomis, "
+                  "tree-split:0.25/nomis; not for bsdf), else MIS is on")
       ->capture_default_str();
   cmd->add_option("--budget", a->budget, "Render seconds per configuration (all points and seeds)")
       ->check(CLI::PositiveNumber)

@@ -39,6 +39,7 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
   d.prim_index = upload_buffer(ctx, geometry.bvh.prim_index);
   d.prims = upload_buffer(ctx, geometry.prims);
   d.materials = upload_buffer(ctx, materials);
+  d.shading_normals = upload_buffer(ctx, geometry.shading_normals); // one element when empty
   upload_light_sampler(ctx, lights, sampler, emission_exponent, d);
   return d;
 }

@@ -34,10 +34,10 @@ std::string KernelFeatures::build_options() const {
   return fmt::format("-DCANOPY_FEATURES_SET -DHAS_LIGHT_POINT={} -DHAS_LIGHT_SPOT={} "
                      "-DHAS_LIGHT_SPHERE={} -DHAS_LIGHT_QUAD={} -DHAS_LIGHT_TRIANGLE={} "
                      "-DHAS_PRIM_SPHERE={} -DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} "
-                     "-DCANOPY_LIGHT_SAMPLER={}",
+                     "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={}",
                      int(light_point), int(light_spot), int(light_sphere), int(light_quad),
                      int(light_triangle), int(prim_sphere), int(material_conductor),
-                     int(material_plastic), light_sampler);
+                     int(material_plastic), light_sampler, int(mis));
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {

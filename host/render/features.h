@@ -14,6 +14,7 @@ struct KernelFeatures {
   bool prim_sphere = false;
   bool material_conductor = false, material_plastic = false;
   int light_sampler = 0; // SAMPLER_* (cl/types.h)
+  bool mis = true;       // RendererOptions::mis
 
   // Everything on (for the test that checks specialisation changes nothing).
   static KernelFeatures all(int light_sampler);

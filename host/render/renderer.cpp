@@ -143,6 +143,7 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   t0 = Clock::now();
   KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_.kind)
                                                  : scene_features(scene, sampler_.kind);
+  features.mis = options.mis;
   stats_.kernel_options = features.build_options();
   program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);

@@ -780,14 +780,18 @@ float3 JsonValue::as_emission() const {
 }
 
 float3 JsonValue::as_albedo() const {
+  return as_color_in(0.0f, 1.0f);
+}
+
+float3 JsonValue::as_color_in(float lo, float hi) const {
   if (is_number()) {
-    float g = as_float_in(0.0f, 1.0f);
+    float g = as_float_in(lo, hi);
     return make_float3(g, g, g);
   }
   if (!is_array() || node().n != 3) fail("must be a number or an array of 3 numbers");
   float c[3];
   for (size_t i = 0; i < 3; ++i)
-    c[i] = at(i).as_float_in(0.0f, 1.0f);
+    c[i] = at(i).as_float_in(lo, hi);
   return make_float3(c[0], c[1], c[2]);
 }
 

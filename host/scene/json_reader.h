@@ -121,6 +121,8 @@ public:
   float3 as_emission() const;
   // Reflectance: components in [0, 1].
   float3 as_albedo() const;
+  // A colour with every component in [lo, hi].
+  float3 as_color_in(float lo, float hi) const;
 
   size_t array_size() const;
   JsonValue at(size_t i) const; // requires an array

@@ -51,6 +51,11 @@ struct Transform {
            m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
   }
   bool flips() const { return det() < 0.0f; }
+  // The transformed direction of a surface normal n: the inverse transpose of m applied to n,
+  // up to a positive factor (the cofactor matrix, sign-corrected by det), unit length; (0,0,0)
+  // if n is zero or not finite, or the result cannot be normalised. In double, so a tiny or huge
+  // normal still normalises.
+  float3 apply_normal(float3 n) const;
   // this ∘ other: first other, then this.
   Transform then(const Transform& outer) const;
   static Transform translate(float3 d);
@@ -65,6 +70,11 @@ struct Mesh {
   std::vector<int32_t> material; // per triangle
   std::vector<float3> emission;  // per triangle radiance; (0,0,0) = not emissive
   bool two_sided_emission = false;
+  // Vertex normals (OBJ vn, local space, as given: not normalised) and, for each triangle, the
+  // indices of its three vertices' normals (-1: none). normal_indices is empty for a mesh without
+  // normals, else 3 per triangle.
+  std::vector<float3> normals;
+  std::vector<int32_t> normal_indices;
 
   size_t triangle_count() const { return indices.size() / 3; }
   void add_triangle(uint32_t a, uint32_t b, uint32_t c, int32_t mat, float3 em) {
@@ -89,10 +99,12 @@ struct Builder {
 
   // Index of the material named by a JSON string value, or an error at that value.
   int material_ref(const JsonValue& v) const;
-  // Index of an MTL material (created on first use) unless the scene defines one with that name.
-  int mtl_material(const std::string& mtl_file, const std::string& name, float3 kd);
-  // Appends a mesh to the triangle soup (transformed) and creates its mesh lights. Returns the
-  // index of its first triangle.
+  // Index of the material `d` of an MTL file (added on first use), unless the scene defines one
+  // with the name d.name.
+  int mtl_material(const std::string& mtl_file, const MaterialDesc& d);
+  // Appends a mesh to the triangle soup (transformed) and creates its mesh lights; its vertex
+  // normals become shading normals (a triangle with a zero or non-finite normal stays flat).
+  // Returns the index of its first triangle.
   size_t add_mesh(const Mesh& mesh, const Transform& xf);
 };
 

@@ -1,5 +1,6 @@
-// OBJ + MTL meshes via tinyobjloader. MTL Kd becomes a diffuse material named after the MTL
-// material; MTL Ke > 0 makes the material's triangles emitters (radiance Ke).
+// OBJ + MTL meshes via tinyobjloader. An MTL material becomes a diffuse or plastic material named
+// after it (mtl_to_material: Kd, Ks, Ns, Ni, illum); MTL Ke > 0 makes the material's triangles
+// emitters (radiance Ke). Vertex normals (vn) become shading normals.
 #include "scene/loader_internal.h"
 
 #include <fmt/format.h>
@@ -139,6 +140,37 @@ bool finite_nonneg3(const tinyobj::real_t* c) {
   return true;
 }
 
+// GGX roughness for a Phong exponent Ns: Walter et al. 2007 ("Microfacet Models for Refraction
+// through Rough Surfaces", eq. 33) match a Blinn-Phong exponent n to Beckmann's
+// alpha = sqrt(2 / (n + 2)); GGX takes the same alpha (their section 5.2 compares the two at
+// equal alpha), and roughness = sqrt(alpha) since alpha = roughness^2. Ns = 0 gives roughness 1.
+float roughness_from_ns(double ns) {
+  double alpha = std::sqrt(2.0 / (ns + 2.0));
+  return float(std::sqrt(alpha));
+}
+
+// The scene material of an MTL material (docs/scene-format.md, "MTL materials"): illum 0 or 1, or
+// Ks = 0, is diffuse Kd; illum >= 2 with Ks > 0 is plastic with albedo Kd, specular Ks, the
+// roughness of Ns and ior Ni (Ni <= 1, MTL's default and tinyobjloader's value for a missing Ni,
+// means unset: 1.5). `fail` reports a problem with the material.
+template <class Fail> MaterialDesc mtl_to_material(const tinyobj::material_t& mt, Fail fail) {
+  const std::string mname = printable(mt.name);
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(mt.diffuse[c]) || mt.diffuse[c] < 0 || mt.diffuse[c] > 1)
+      fail(fmt::format("material '{}': Kd must be in [0, 1]", mname));
+  if (!finite_nonneg3(mt.specular)) fail(fmt::format("material '{}': Ks must be >= 0", mname));
+  float3 kd = make_float3(mt.diffuse[0], mt.diffuse[1], mt.diffuse[2]);
+  float3 ks = make_float3(mt.specular[0], mt.specular[1], mt.specular[2]);
+  bool glossy = mt.illum >= 2 && (ks.x > 0.0f || ks.y > 0.0f || ks.z > 0.0f);
+  if (!glossy) return diffuse_material(mt.name, kd);
+  if (!std::isfinite(mt.shininess) || mt.shininess < 0)
+    fail(fmt::format("material '{}': Ns must be >= 0", mname));
+  if (!std::isfinite(mt.ior) || mt.ior > kMaxPlasticIor)
+    fail(fmt::format("material '{}': Ni must be <= {}", mname, kMaxPlasticIor));
+  float ior = mt.ior > 1.0f ? float(mt.ior) : kDefaultPlasticIor;
+  return plastic_material(mt.name, kd, ks, roughness_from_ns(double(mt.shininess)), ior);
+}
+
 } // namespace
 
 Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b,
@@ -179,24 +211,30 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     m.vertices[i] = make_float3(x, y, z);
   }
 
+  // Vertex normals as given (add_mesh normalises them after the transform; a zero or non-finite
+  // one makes its triangles flat). check_obj_text has already refused non-finite numbers.
+  size_t nn = attrib.normals.size() / 3;
+  m.normals.resize(nn);
+  for (size_t i = 0; i < nn; ++i)
+    m.normals[i] =
+        make_float3(attrib.normals[3 * i], attrib.normals[3 * i + 1], attrib.normals[3 * i + 2]);
+
   // Materials of the MTL, resolved once.
   std::vector<int> mat_index(materials.size(), 0);
   std::vector<float3> mat_emission(materials.size(), make_float3(0, 0, 0));
+  auto mtl_fail = [&](const std::string& problem) {
+    at.fail(fmt::format("{}: {}", name, problem));
+  };
   for (size_t i = 0; i < materials.size(); ++i) {
     const auto& mt = materials[i];
-    for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(mt.diffuse[c]) || mt.diffuse[c] < 0 || mt.diffuse[c] > 1)
-        at.fail(fmt::format("{}: material '{}': Kd must be in [0, 1]", name, printable(mt.name)));
+    MaterialDesc d = mtl_to_material(mt, mtl_fail);
     if (!finite_nonneg3(mt.emission))
-      at.fail(fmt::format("{}: material '{}': Ke must be >= 0", name, printable(mt.name)));
+      mtl_fail(fmt::format("material '{}': Ke must be >= 0", printable(mt.name)));
     mat_emission[i] = make_float3(mt.emission[0], mt.emission[1], mt.emission[2]);
-    if (material_override < 0)
-      mat_index[i] =
-          b.mtl_material(name, mt.name, make_float3(mt.diffuse[0], mt.diffuse[1], mt.diffuse[2]));
-    else
-      mat_index[i] = material_override;
+    mat_index[i] = material_override < 0 ? b.mtl_material(name, d) : material_override;
   }
 
+  bool any_normals = false;
   for (const auto& sh : shapes) {
     const auto& mesh = sh.mesh;
     size_t nf = mesh.num_face_vertices.size();
@@ -205,13 +243,27 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
         at.fail(fmt::format("{}: face {} of '{}' is not a triangle after triangulation", name,
                             f + 1, printable(sh.name)));
       uint32_t idx[3];
+      int32_t nidx[3];
+      bool has_normals = true;
       for (int k = 0; k < 3; ++k) {
         int vi = mesh.indices[3 * f + k].vertex_index;
         if (vi < 0 || size_t(vi) >= nv)
           at.fail(fmt::format("{}: face {} of '{}' has a vertex index out of range", name, f + 1,
                               printable(sh.name)));
         idx[k] = uint32_t(vi);
+        int ni = mesh.indices[3 * f + k].normal_index; // -1: the face gives no normal
+        if (ni >= 0 && size_t(ni) >= nn)
+          at.fail(fmt::format("{}: face {} of '{}' has a normal index out of range", name, f + 1,
+                              printable(sh.name)));
+        nidx[k] = ni;
+        has_normals = has_normals && ni >= 0;
       }
+      // normal_indices starts at the first triangle with normals (earlier ones: -1).
+      if (has_normals && !any_normals) m.normal_indices.assign(3 * m.triangle_count(), -1);
+      any_normals = any_normals || has_normals;
+      if (any_normals)
+        for (int k = 0; k < 3; ++k)
+          m.normal_indices.push_back(has_normals ? nidx[k] : -1);
       int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
       int mat = material_override >= 0 ? material_override : 0;
       float3 em = make_float3(0, 0, 0);

@@ -34,6 +34,13 @@ inline constexpr int kMaxFilmSide = 16384;
 inline constexpr int kDefaultMaxCut = 64;
 inline constexpr int kMaxMaxCut = 1 << 16;
 inline constexpr int kMaxDepth = 1024; // path vertices after the camera hit
+// Conductor eta and k (per channel) and plastic ior ranges of the scene format: they hold every
+// measured metal and dielectric in the visible range with a wide margin, and keep the Fresnel
+// arithmetic in float far from underflow (eta^2) and overflow (|eta + ik|^4).
+inline constexpr float kMinConductorEta = 0.01f;
+inline constexpr float kMaxConductorIndex = 1000.0f; // eta and k
+inline constexpr float kMaxPlasticIor = 10.0f;
+inline constexpr float kDefaultPlasticIor = 1.5f;
 
 // `s` made safe to echo inside a one-line message: control characters (including NUL and C1
 // controls), invalid UTF-8 and the Unicode line/paragraph separators become \n, \t, \xHH or
@@ -91,6 +98,34 @@ inline MaterialDesc diffuse_material(std::string name, float3 albedo) {
   return d;
 }
 
+// A conductor: GGX with alpha = roughness^2 (0: a perfect mirror) and the Fresnel reflectance of
+// the complex index eta + i k per RGB channel (cl/types.h keeps eta in `specular`).
+inline MaterialDesc conductor_material(std::string name, float roughness, float3 eta, float3 k) {
+  MaterialDesc d;
+  d.name = std::move(name);
+  d.gpu = Material{};
+  d.gpu.specular = make_float4(eta.x, eta.y, eta.z, 0.0f);
+  d.gpu.k = make_float4(k.x, k.y, k.z, 0.0f);
+  d.gpu.alpha = roughness * roughness;
+  d.gpu.type = MATERIAL_CONDUCTOR;
+  return d;
+}
+
+// pbrt-v3's plastic: albedo / pi plus specular * a GGX lobe (alpha = roughness^2) with the
+// dielectric Fresnel reflectance of index `ior`.
+inline MaterialDesc plastic_material(std::string name, float3 albedo, float3 specular,
+                                     float roughness, float ior) {
+  MaterialDesc d;
+  d.name = std::move(name);
+  d.gpu = Material{};
+  d.gpu.albedo = make_float4(albedo.x, albedo.y, albedo.z, 0.0f);
+  d.gpu.specular = make_float4(specular.x, specular.y, specular.z, 0.0f);
+  d.gpu.alpha = roughness * roughness;
+  d.gpu.ior = ior;
+  d.gpu.type = MATERIAL_PLASTIC;
+  return d;
+}
+
 // All geometry flattened into one world-space triangle soup. Emissive mesh triangles (OBJ/MTL Ke
 // or an emission given in the scene) have a TRIANGLE light with LIGHT_FLAG_FROM_MESH and
 // triangle_light[i] pointing at it. Analytic area lights (sphere, quad, triangle) are NOT in this
@@ -105,6 +140,11 @@ struct Scene {
   std::vector<uint32_t> indices;          // 3 per triangle
   std::vector<int32_t> triangle_material; // per triangle
   std::vector<int32_t> triangle_light;    // per triangle, -1 if not emissive
+  // Shading normals (OBJ vn): the unit world-space normals at the three vertices of each smooth
+  // triangle, in the triangle's vertex order; triangle_normals[t] is the index of triangle t's
+  // first one, or -1 for a flat triangle. triangle_normals is empty while every triangle is flat.
+  std::vector<float3> shading_normals;
+  std::vector<int32_t> triangle_normals;
   std::vector<Light> lights; // only lights that emit (zero-emission lights are skipped)
   size_t skipped_lights = 0; // lights given with zero emission, not in `lights`
 

@@ -1,5 +1,6 @@
 // load_scene / load_scene_from_string: the top level of the scene format (docs/scene-format.md).
 #include "scene/loader_internal.h"
+#include "scene/metal_presets.h"
 
 #include <fmt/format.h>
 
@@ -20,6 +21,30 @@ Transform Transform::then(const Transform& outer) const {
       r.m[i][j] = outer.m[i][0] * m[0][j] + outer.m[i][1] * m[1][j] + outer.m[i][2] * m[2][j];
   r.t = outer.apply(t);
   return r;
+}
+
+float3 Transform::apply_normal(float3 n) const {
+  double a[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      a[i][j] = double(m[i][j]);
+  // Cofactor matrix C = det(M) M^-T: normals transform by M^-T; C avoids the division, and the
+  // sign of det keeps the direction (a mirror must not turn the normal inside out).
+  double c[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      c[i][j] = a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1];
+    }
+  double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+  double s = det < 0.0 ? -1.0 : 1.0;
+  double x = double(n.x), y = double(n.y), z = double(n.z);
+  double r[3];
+  for (int i = 0; i < 3; ++i)
+    r[i] = s * (c[i][0] * x + c[i][1] * y + c[i][2] * z);
+  double len = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+  if (!(len > 0.0) || !std::isfinite(len)) return make_float3(0, 0, 0);
+  return make_float3(float(r[0] / len), float(r[1] / len), float(r[2] / len));
 }
 
 Transform Transform::translate(float3 d) {
@@ -62,12 +87,11 @@ int Builder::material_ref(const JsonValue& v) const {
   return it->second;
 }
 
-int Builder::mtl_material(const std::string& mtl_file, const std::string& name, float3 kd) {
+int Builder::mtl_material(const std::string& mtl_file, const MaterialDesc& d) {
   // A scene material with the same name wins: it lets a scene recolour an OBJ.
-  if (auto it = material_by_name.find(name); it != material_by_name.end()) return it->second;
-  std::string key = mtl_file + "\n" + name;
+  if (auto it = material_by_name.find(d.name); it != material_by_name.end()) return it->second;
+  std::string key = mtl_file + "\n" + d.name;
   if (auto it = mtl_material_by_key.find(key); it != mtl_material_by_key.end()) return it->second;
-  MaterialDesc d = diffuse_material(name, kd);
   int idx = int(scene.materials.size());
   scene.materials.push_back(d);
   mtl_material_by_key.emplace(key, idx);
@@ -96,12 +120,45 @@ size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
   reserve_more(s.indices, 3 * nt);
   reserve_more(s.triangle_material, nt);
   reserve_more(s.triangle_light, nt);
+  // Shading normals: world-space unit normals, transformed once per mesh normal.
+  const bool smooth = !mesh.normal_indices.empty();
+  std::vector<float3> world_normals;
+  if (smooth) {
+    world_normals.resize(mesh.normals.size());
+    for (size_t i = 0; i < mesh.normals.size(); ++i)
+      world_normals[i] = xf.apply_normal(mesh.normals[i]);
+    if (s.triangle_normals.empty()) s.triangle_normals.assign(first_tri, -1);
+    reserve_more(s.shading_normals, 3 * nt);
+  }
+  if (!s.triangle_normals.empty()) reserve_more(s.triangle_normals, nt);
   for (size_t t = 0; t < nt; ++t) {
     uint32_t a = base + mesh.indices[3 * t], bb = base + mesh.indices[3 * t + 1],
              c = base + mesh.indices[3 * t + 2];
     if (flip) std::swap(bb, c);
     s.indices.insert(s.indices.end(), {a, bb, c});
     s.triangle_material.push_back(mesh.material[t]);
+    if (smooth) {
+      // A triangle without a normal at every vertex, or with a zero or non-finite one, is flat.
+      float3 n[3];
+      bool ok = true;
+      for (int k = 0; k < 3; ++k) {
+        int32_t ni = mesh.normal_indices[3 * t + size_t(k)];
+        n[k] = ni < 0 ? make_float3(0, 0, 0) : world_normals[size_t(ni)];
+        ok = ok && (n[k].x != 0.0f || n[k].y != 0.0f || n[k].z != 0.0f);
+      }
+      if (flip) std::swap(n[1], n[2]);
+      int32_t first = -1;
+      if (ok) {
+        if (s.shading_normals.size() + 3 > size_t(std::numeric_limits<int32_t>::max()))
+          throw SceneError(
+              fmt::format("{}: shapes: too many shading normals (more than 2^31)", file));
+        first = int32_t(s.shading_normals.size());
+        s.shading_normals.insert(s.shading_normals.end(), {n[0], n[1], n[2]});
+      }
+      s.triangle_normals.push_back(first);
+    } else if (!s.triangle_normals.empty()) {
+      s.triangle_normals.push_back(-1);
+    }
     int32_t light = -1;
     float3 em = mesh.emission[t];
     if (em.x > 0.0f || em.y > 0.0f || em.z > 0.0f) {
@@ -177,26 +234,65 @@ void parse_film(const JsonValue& v, FilmSettings& film) {
 
 void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
   auto o = v.as_object();
-  o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "max_cut", "seed"});
+  o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "max_cut", "seed", "mis"});
   if (auto x = o.get("spp")) in.spp = int(x->as_int(1, kMaxSpp));
   if (auto x = o.get("max_depth")) in.max_depth = int(x->as_int(1, kMaxDepth));
   if (auto x = o.get("light_sampler")) in.light_sampler = x->as_enum(kLightSamplerNames);
   if (auto x = o.get("split_threshold")) in.split_threshold = x->as_float_in(0.0f, 1.0f);
   if (auto x = o.get("max_cut")) in.max_cut = int(x->as_int(1, kMaxMaxCut));
   if (auto x = o.get("seed")) in.seed = uint32_t(x->as_int(0, 0xffffffffLL));
+  if (auto x = o.get("mis")) in.mis = x->as_bool();
+}
+
+// One entry of "materials" (docs/scene-format.md, Materials). Roughness r becomes GGX alpha = r^2.
+MaterialDesc parse_material(const JsonValue& v) {
+  auto o = v.as_object();
+  auto nv = o.req("name");
+  std::string name = nv.as_string();
+  if (name.empty()) nv.fail("must not be empty");
+  std::string type = "diffuse"; // the default keeps scenes written before glossy materials valid
+  if (auto t = o.get("type")) type = t->as_enum({"diffuse", "conductor", "plastic"});
+  if (type == "diffuse") {
+    o.allow({"name", "type", "albedo"});
+    return diffuse_material(name, o.req("albedo").as_albedo());
+  }
+  if (type == "conductor") {
+    o.allow({"name", "type", "roughness", "metal", "eta", "k"});
+    float r = o.req("roughness").as_float_in(0.0f, 1.0f);
+    auto metal = o.get("metal");
+    auto eta = o.get("eta");
+    auto k = o.get("k");
+    if (metal) {
+      // The message names eta if both eta and k are given.
+      for (const auto& x : {eta, k})
+        if (x) x->fail("not allowed together with \"metal\" (give a preset or eta and k)");
+      const MetalPreset* p = find_metal_preset(metal->as_enum(metal_preset_names()));
+      return conductor_material(name, r, make_float3(p->eta[0], p->eta[1], p->eta[2]),
+                                make_float3(p->k[0], p->k[1], p->k[2]));
+    }
+    if (!eta && !k) o.fail("a conductor needs \"metal\" (a preset name) or \"eta\" and \"k\"");
+    float3 e = o.req("eta").as_color_in(kMinConductorEta, kMaxConductorIndex);
+    float3 kk = o.req("k").as_color_in(0.0f, kMaxConductorIndex);
+    return conductor_material(name, r, e, kk);
+  }
+  // plastic
+  o.allow({"name", "type", "albedo", "specular", "roughness", "ior"});
+  float3 albedo = o.req("albedo").as_albedo();
+  float3 spec = make_float3(1, 1, 1);
+  if (auto sp = o.get("specular")) spec = sp->as_color();
+  float r = o.req("roughness").as_float_in(0.0f, 1.0f);
+  float ior = kDefaultPlasticIor;
+  if (auto i = o.get("ior")) ior = i->as_float_in(1.0f, kMaxPlasticIor);
+  return plastic_material(name, albedo, spec, r, ior);
 }
 
 void parse_materials(const JsonValue& v, Builder& b) {
   Scene& s = b.scene;
   bool default_replaced = false;
   for (const JsonValue& mv : v.as_array()) {
-    auto o = mv.as_object();
-    o.allow({"name", "type", "albedo"});
-    auto nv = o.req("name");
-    std::string name = nv.as_string();
-    if (name.empty()) nv.fail("must not be empty");
-    if (auto t = o.get("type")) t->as_enum({"diffuse"});
-    MaterialDesc d = diffuse_material(name, o.req("albedo").as_albedo());
+    MaterialDesc d = parse_material(mv);
+    const std::string& name = d.name;
+    auto nv = mv.as_object().req("name");
     if (name == "default" && !default_replaced) {
       s.materials[0] = d; // replaces the built-in default
       default_replaced = true;

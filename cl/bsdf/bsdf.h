@@ -1,0 +1,58 @@
+// BSDF interface: evaluation, pdf and sampling of a Material in the local shading frame
+// (z = shading normal, wo.z > 0: the caller flips the frame to face wo). Dispatches on
+// Material.type; the conductor and plastic code is compiled only when the kernel has those
+// features (cl/kernel_features.h), so a diffuse-only kernel holds no GGX or Fresnel code.
+//   bsdf_eval   f(wo, wi) of the non-delta lobes (0 below the horizon: reflection only)
+//   bsdf_pdf    solid-angle pdf of bsdf_sample's non-delta directions
+//   bsdf_sample a direction from u (3 uniforms in [0, 1)): see BsdfSample (bsdf_sample.h)
+//   bsdf_has_smooth_lobe 0 only for a pure delta BSDF (light sampling is then useless)
+// `m` points to a private copy of the material record.
+#ifndef CANOPY_CL_BSDF_BSDF_H
+#define CANOPY_CL_BSDF_BSDF_H
+
+#include "../compat.h"
+#include "../kernel_features.h"
+#include "../types.h"
+#include "bsdf_sample.h"
+#include "conductor.h"
+#include "diffuse.h"
+#include "plastic.h"
+
+INLINE float3 bsdf_eval(const Material* m, float3 wo, float3 wi) {
+#if HAS_MATERIAL_CONDUCTOR
+  if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_eval(m, wo, wi);
+#endif
+#if HAS_MATERIAL_PLASTIC
+  if (IS_MATERIAL(m, MATERIAL_PLASTIC)) return plastic_eval(m, wo, wi);
+#endif
+  return diffuse_eval(m, wo, wi);
+}
+
+INLINE float bsdf_pdf(const Material* m, float3 wo, float3 wi) {
+  (void)m; // diffuse_pdf needs no parameters (unused in a diffuse-only kernel)
+#if HAS_MATERIAL_CONDUCTOR
+  if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_pdf(m, wo, wi);
+#endif
+#if HAS_MATERIAL_PLASTIC
+  if (IS_MATERIAL(m, MATERIAL_PLASTIC)) return plastic_pdf(m, wo, wi);
+#endif
+  return diffuse_pdf(wo, wi);
+}
+
+INLINE BsdfSample bsdf_sample(const Material* m, float3 wo, float3 u) {
+#if HAS_MATERIAL_CONDUCTOR
+  if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_sample(m, wo, u);
+#endif
+#if HAS_MATERIAL_PLASTIC
+  if (IS_MATERIAL(m, MATERIAL_PLASTIC)) return plastic_sample(m, wo, u);
+#endif
+  return diffuse_sample(m, wo, u);
+}
+
+INLINE int bsdf_has_smooth_lobe(const Material* m) {
+  if (IS_MATERIAL(m, MATERIAL_CONDUCTOR))
+    return m->alpha > 0.0f; // not ggx_is_delta: compiled without HAS_MICROFACET too
+  return 1;
+}
+
+#endif // CANOPY_CL_BSDF_BSDF_H
