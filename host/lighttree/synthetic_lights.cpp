@@ -1,6 +1,7 @@
 #include "lighttree/synthetic_lights.h"
 
 #include "light_tree_math.h"
+#include "shading.h"
 
 #include <cmath>
 
@@ -67,6 +68,18 @@ Light make_triangle_light(float3 v0, float3 v1, float3 v2, float3 radiance, bool
   l.e1 = f4_from3(e1, 0.0f);
   l.e2 = f4_from3(e2, 0.0f);
   l.n = f4_from3(normalize(c), 0.5f * length(c));
+  l.emission = f4_from3(radiance, 0.0f);
+  l.flags = two_sided ? LIGHT_FLAG_TWO_SIDED : 0;
+  return l;
+}
+Light make_disk_light(float3 c, float3 normal, float radius, float3 radiance, bool two_sided) {
+  Light l = blank(LIGHT_DISK);
+  float3 n = normalize(normal), t1, t2;
+  onb_from(n, &t1, &t2);
+  l.p = f4_from3(c, radius);
+  l.e1 = f4_from3(t1, 0.0f);
+  l.e2 = f4_from3(t2, 0.0f);
+  l.n = f4_from3(n, float(M_PI * double(radius) * double(radius)));
   l.emission = f4_from3(radiance, 0.0f);
   l.flags = two_sided ? LIGHT_FLAG_TWO_SIDED : 0;
   return l;
@@ -168,7 +181,7 @@ std::vector<Light> mixed_lights(int n, uint32_t seed, float size) {
     float3 c = make_float3(r.u(0, size), r.u(0, size), r.u(0, size));
     float s = size * r.u(0.005f, 0.05f);
     float3 col = r.color(0.1f, 5.0f);
-    switch (i % 7) {
+    switch (i % 9) {
     case 0:
       out.push_back(make_point_light(c, col));
       break;
@@ -183,9 +196,13 @@ std::vector<Light> mixed_lights(int n, uint32_t seed, float size) {
     case 3:
     case 4: {
       float3 nrm = r.unit(), t = lt_any_perpendicular(nrm), b = cross(nrm, t);
-      out.push_back(make_quad_light(c, t * s, b * (s * r.u(0.3f, 2.0f)), col, i % 7 == 4));
+      out.push_back(make_quad_light(c, t * s, b * (s * r.u(0.3f, 2.0f)), col, i % 9 == 4));
       break;
     }
+    case 7:
+    case 8:
+      out.push_back(make_disk_light(c, r.unit(), s, col, i % 9 == 8));
+      break;
     default: {
       float3 v1 = c + r.unit() * s, v2 = c + r.unit() * s;
       out.push_back(make_triangle_light(c, v1, v2, col, r.u() < 0.2f));
