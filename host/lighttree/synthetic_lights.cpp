@@ -174,14 +174,24 @@ std::vector<Light> spiral_lights(int n) {
 }
 
 std::vector<Light> mixed_lights(int n, uint32_t seed, float size) {
-  R r(seed, 4);
+  // Every eighth light is a disk drawn from its own stream, so the other lights are the same
+  // sequence (point, spot, sphere, quad, two-sided quad, two triangles) as without disks.
+  R r(seed, 4), rd(seed, 5);
   std::vector<Light> out;
   out.reserve(n);
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0, j = 0; i < n; ++i) {
+    if (i % 8 == 7) {
+      float3 c = make_float3(rd.u(0, size), rd.u(0, size), rd.u(0, size));
+      float s = size * rd.u(0.005f, 0.05f);
+      float3 col = rd.color(0.1f, 5.0f);
+      float3 nrm = rd.unit();
+      out.push_back(make_disk_light(c, nrm, s, col, (i / 8) % 3 == 2)); // a third two-sided
+      continue;
+    }
     float3 c = make_float3(r.u(0, size), r.u(0, size), r.u(0, size));
     float s = size * r.u(0.005f, 0.05f);
     float3 col = r.color(0.1f, 5.0f);
-    switch (i % 9) {
+    switch (j++ % 7) {
     case 0:
       out.push_back(make_point_light(c, col));
       break;
@@ -196,13 +206,9 @@ std::vector<Light> mixed_lights(int n, uint32_t seed, float size) {
     case 3:
     case 4: {
       float3 nrm = r.unit(), t = lt_any_perpendicular(nrm), b = cross(nrm, t);
-      out.push_back(make_quad_light(c, t * s, b * (s * r.u(0.3f, 2.0f)), col, i % 9 == 4));
+      out.push_back(make_quad_light(c, t * s, b * (s * r.u(0.3f, 2.0f)), col, (j - 1) % 7 == 4));
       break;
     }
-    case 7:
-    case 8:
-      out.push_back(make_disk_light(c, r.unit(), s, col, i % 9 == 8));
-      break;
     default: {
       float3 v1 = c + r.unit() * s, v2 = c + r.unit() * s;
       out.push_back(make_triangle_light(c, v1, v2, col, r.u() < 0.2f));
