@@ -93,8 +93,33 @@ INLINE int ray_sphere(float3 o, float3 d, float3 c, float r, float tmin, float t
   return 1;
 }
 
+// Ray-disk (centre c, unit normal n, radius r): the ray-plane distance t = n.(c - o) / n.d, a hit
+// when the plane point lies within r of c. Both faces are hit (emission is one-sided, the shape
+// is not). A root within the rounding error of t is the surface the ray leaves, rejected as for
+// triangles: the numerator's error is about gamma(4) n.|c - o| (the difference rounded, the dot
+// product; gamma(8) keeps a margin), divided by |n.d|, plus the division's relative error.
+INLINE int ray_disk(float3 o, float3 d, float3 c, float3 n, float r, float tmin, float tmax,
+                    float* t_out) {
+  float dn = dot(n, d);
+  if (dn == 0.0f) return 0;
+  float3 co = c - o;
+  float t = dot(n, co) / dn;
+  if (!(t > tmin && t < tmax)) return 0;
+  float t_err = fp_gamma(8) * dot(fabs(n), fabs(co)) / fabs(dn) + fp_gamma(4) * t;
+  if (t <= t_err) return 0;
+  float3 q = d * t - co; // hit point relative to the centre
+  if (!(dot(q, q) <= r * r)) return 0;
+  *t_out = t;
+  return 1;
+}
+
 INLINE int ray_primitive(const GLOBAL Primitive* prim, float3 o, float3 d, float tmin, float tmax,
                          float* t, float* u, float* v) {
+  if (IS_PRIM(prim, PRIM_DISK)) {
+    *u = 0.0f;
+    *v = 0.0f;
+    return ray_disk(o, d, xyz_of(prim->v0), xyz_of(prim->e1), prim->v0.w, tmin, tmax, t);
+  }
   if (IS_PRIM(prim, PRIM_SPHERE)) {
     *u = 0.0f;
     *v = 0.0f;
@@ -208,9 +233,18 @@ INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL int* prim_ind
 // component, for offset_ray_origin. A triangle's point comes from its barycentrics (v0 + u e1 +
 // v e2 lies on the triangle's plane for any u, v; only the rounding of that sum is error), not
 // from o + t d, whose error grows with t and with |o|. A sphere's point is o + t d projected back
-// onto the sphere.
+// onto the sphere; a disk's, o + t d projected onto its plane (its error then follows the centre's
+// coordinates and the offset within the disk: the projection's dot product and the two sums).
 INLINE float3 primitive_hit_point(const GLOBAL Primitive* prim, float3 o, float3 d, Hit h,
                                   float3* p_err) {
+  if (IS_PRIM(prim, PRIM_DISK)) {
+    float3 c = xyz_of(prim->v0), n = xyz_of(prim->e1);
+    float3 q = (o + d * h.t) - c;
+    q = q - n * dot(n, q);
+    float3 p = c + q;
+    *p_err = (fabs(c) + fabs(q)) * fp_gamma(6);
+    return p;
+  }
   if (IS_PRIM(prim, PRIM_SPHERE)) {
     float3 c = xyz_of(prim->v0);
     float r = prim->v0.w;
@@ -229,6 +263,7 @@ INLINE float3 primitive_hit_point(const GLOBAL Primitive* prim, float3 o, float3
 
 // Geometric normal of a primitive at a hit point (not normalised to face the ray).
 INLINE float3 primitive_normal(const GLOBAL Primitive* prim, float3 p) {
+  if (IS_PRIM(prim, PRIM_DISK)) return xyz_of(prim->e1);
   if (IS_PRIM(prim, PRIM_SPHERE)) return normalize(p - xyz_of(prim->v0));
   return normalize(cross(xyz_of(prim->e1), xyz_of(prim->e2)));
 }

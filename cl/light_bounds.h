@@ -13,7 +13,7 @@
 // points/spheres/two-sided; a spot has theta_o = 0, theta_e = aperture, and an aperture beyond pi/2
 // becomes theta_o = aperture - pi/2, theta_e = pi/2 so theta_e <= pi/2 always), and energy: the
 // luminance of the maximum radiant intensity: I for point/spot, L pi r^2 for a sphere, L A for a
-// quad/triangle (Conty & Kulla §5.1). Non-finite or negative energies count as 0.
+// quad/triangle/disk (Conty & Kulla §5.1). Non-finite or negative energies count as 0.
 LT_HOT void lt_light_bounds(GLOBAL const Light* L, float3* bmin, float3* bmax, float3* axis,
                             float* cos_o, float* cos_e, float* energy) {
   float3 p = xyz_of(L->p);
@@ -65,6 +65,24 @@ LT_HOT void lt_light_bounds(GLOBAL const Light* L, float3* bmin, float3* bmax, f
       *bmax = lt_max3(*bmax, q3);
     }
     e = lum * area;
+  } else if (L->type == LIGHT_DISK) {
+    // Oriented like a quad. Box: the disk's extent along axis i is r sqrt(1 - n_i^2) (the
+    // projection of a circle), padded by 2^-20 of r and of |centre| so the box holds the sampled
+    // points despite their rounding (cl/light_sample.h).
+    float3 n = xyz_of(L->n);
+    float r = fabs(L->p.w);
+    float nl = length(n);
+    if (nl > 0.0f) *axis = n * (1.0f / nl);
+    *cos_o = (L->flags & LIGHT_FLAG_TWO_SIDED) ? -1.0f : 1.0f;
+    float3 a = *axis;
+    float3 ext =
+        make_float3(sqrt(lt_maxf(1.0f - a.x * a.x, 0.0f)), sqrt(lt_maxf(1.0f - a.y * a.y, 0.0f)),
+                    sqrt(lt_maxf(1.0f - a.z * a.z, 0.0f))) *
+            (r * 1.000001f) +
+        fabs(p) * 9.5367432e-07f;
+    *bmin = p - ext;
+    *bmax = p + ext;
+    e = lum * M_PI_F * r * r; // L A: the intensity along the normal, as for a quad
   }
   *energy = (e > 0.0f && is_finite_f(e)) ? e : 0.0f;
 }

@@ -54,6 +54,42 @@ INLINE float3 area_light_shadow_end(const GLOBAL Light* l, float3 q, float3 P) {
   return offset_ray_origin(q, q_err, dot(ln, P - q) >= 0.0f ? ln : -ln);
 }
 
+// Concentric map of the unit square onto the unit disk (Shirley & Chiu 1997): area-preserving up
+// to a constant, so uniform (u1, u2) give a uniform point on the disk, with less distortion than
+// the polar map (r = sqrt(u1)).
+INLINE float2 concentric_disk(float u1, float u2) {
+  float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f;
+  if (a == 0.0f && b == 0.0f) return make_float2(0.0f, 0.0f);
+  float rr, phi;
+  if (fabs(a) > fabs(b)) {
+    rr = a;
+    phi = (0.25f * CANOPY_PI) * (b / a);
+  } else {
+    rr = b;
+    phi = 0.5f * CANOPY_PI - (0.25f * CANOPY_PI) * (a / b);
+  }
+  return make_float2(rr * cos(phi), rr * sin(phi));
+}
+
+// Solid-angle pdf of the direction from P to the point x on disk light l under uniform area
+// sampling: d^2 / (|cos_l| A), 0 where the disk does not emit towards P (for the MIS weight of a
+// BSDF ray that hit the back of a one-sided disk: it carries no emission). sample_light's disk
+// branch and light_pdf both call it with the point they have (the sample's s.x, the BSDF ray's
+// hit point), so they agree exactly for the same point.
+INLINE float disk_light_pdf(const GLOBAL Light* l, float3 P, float3 x) {
+  float3 to = x - P;
+  float d2 = dot(to, to);
+  if (!(d2 > 0.0f)) return 0.0f;
+  float3 w = to / sqrt(d2);
+  float3 ln = xyz_of(l->n);
+  // A one-sided disk emits towards P when P is in front of its plane: tested against the centre,
+  // not x, so the answer does not depend on which side of the plane x was rounded to.
+  if (!(l->flags & LIGHT_FLAG_TWO_SIDED) && !(dot(ln, P - xyz_of(l->p)) > 0.0f)) return 0.0f;
+  float cos_l = fabs(dot(ln, w));
+  float pdf = cos_l > 0.0f ? d2 / (cos_l * l->n.w) : 0.0f;
+  return is_finite_f(pdf) ? pdf : 0.0f;
+}
+
 INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float u2) {
   LightSample s;
   s.wi = make_float3(0.0f, 0.0f, 1.0f);
@@ -123,6 +159,30 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
     }
     return s;
   }
+  if (IS_LIGHT(l, LIGHT_DISK)) {
+    // Uniform in area (concentric map), converted to solid angle: pdf = d^2 / (|cos_l| A).
+    float3 c = xyz_of(l->p);
+    float r = l->p.w;
+    float3 t1 = xyz_of(l->e1), t2 = xyz_of(l->e2), ln = xyz_of(l->n);
+    float2 uv = concentric_disk(u1, u2);
+    float3 q = c + t1 * (r * uv.x) + t2 * (r * uv.y);
+    // Off the disk's plane towards P by what can put the shadow ray's plane crossing (cl/geometry.h
+    // ray_disk) before its end: q's distance from the plane (the sums, gamma(3) (|c| + r), and the
+    // tangent frame's tilt off the plane, a few ulps of 1 times r), the ray-plane numerator
+    // n.(c - P) (gamma(4) n.(|c| + |P|)) and the direction's normal component (P - q rounded,
+    // normalised, the dot product: gamma(6) n.|q - P| at t ~ dist). All scale with 1/|cos| along
+    // the ray, as the offset does; gamma(16) of n.(|c| + |P| + 2r) bounds their sum.
+    float3 q_err = (fabs(c) + fabs(P) + make_float3(2.0f * r, 2.0f * r, 2.0f * r)) * fp_gamma(16);
+    s.x = offset_ray_origin(q, q_err, dot(ln, P - c) >= 0.0f ? ln : -ln);
+    float3 to = s.x - P;
+    float d2 = dot(to, to);
+    if (!(d2 > 0.0f)) return s;
+    s.dist = sqrt(d2);
+    s.wi = to / s.dist;
+    s.pdf = disk_light_pdf(l, P, s.x);
+    if (s.pdf > 0.0f) s.Li = L;
+    return s;
+  }
   // Quad and triangle: uniform in solid angle where float precision allows, else uniform in area
   // converted to solid angle (cl/lights/planar_solid_angle.h).
   if (!(IS_LIGHT(l, LIGHT_QUAD) || IS_LIGHT(l, LIGHT_TRIANGLE))) return s;
@@ -172,6 +232,9 @@ INLINE float3 light_emitted_radiance(const GLOBAL Light* l, float3 surface_norma
   if (IS_LIGHT(l, LIGHT_QUAD) || IS_LIGHT(l, LIGHT_TRIANGLE)) {
     return light_emits_towards(l, w_out) ? xyz_of(l->emission) : make_float3(0.0f, 0.0f, 0.0f);
   }
+  if (IS_LIGHT(l, LIGHT_DISK)) {
+    return light_emits_towards(l, w_out) ? xyz_of(l->emission) : make_float3(0.0f, 0.0f, 0.0f);
+  }
   return make_float3(0.0f, 0.0f, 0.0f);
 }
 
@@ -201,6 +264,7 @@ INLINE float light_pdf(const GLOBAL Light* l, float3 P, float3 x) {
     float cos_l = fabs(dot(xyz_of(l->n), w));
     return cos_l > 0.0f ? d2 / (cos_l * l->n.w) : 0.0f;
   }
+  if (IS_LIGHT(l, LIGHT_DISK)) return disk_light_pdf(l, P, x);
   return 0.0f; // delta lights cannot be hit
 }
 

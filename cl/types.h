@@ -12,21 +12,26 @@
 #define LIGHT_SPHERE 2   // spherical area light: radiance L [W/(m^2 sr)], radius r
 #define LIGHT_QUAD 3     // parallelogram area light: radiance L, one- or two-sided
 #define LIGHT_TRIANGLE 4 // triangle area light: radiance L (also every emissive mesh triangle)
-#define LIGHT_TYPE_COUNT 5
+#define LIGHT_DISK 5     // disk area light: radiance L, one- or two-sided
+#define LIGHT_TYPE_COUNT 6
 
-#define LIGHT_FLAG_TWO_SIDED 1 // quad/triangle emit on both faces
+#define LIGHT_FLAG_TWO_SIDED 1 // quad/triangle/disk emit on both faces
 #define LIGHT_FLAG_FROM_MESH 2 // triangle is part of a mesh already in the geometry
 
 typedef struct Light {
-  float4 p; // point/spot/sphere: position (xyz), sphere radius (w). quad: corner. triangle: v0.
+  // point/spot/sphere: position (xyz), sphere radius (w). quad: corner. triangle: v0. disk: centre
+  // (xyz), radius (w).
+  float4 p;
   // quad: edge 1; triangle: v1 - v0; spot: unit axis (xyz), cos of the cone half-angle rounded
-  // down (w; a bound that only ever widens the cone, for the light tree).
+  // down (w; a bound that only ever widens the cone, for the light tree). disk: unit tangent t1
+  // (xyz) of the orthonormal frame (t1, t2, n), w unused.
   float4 e1;
   // quad: edge 2; triangle: v2 - v0; spot: 1 - cos of the cone half-angle (x) and of the
   // falloff-start half-angle (y), both from 2 sin^2(angle / 2) in double (the falloff works in
-  // 1 - cos, exact for narrow cones, cl/light_sample.h); cos of the falloff start (w).
+  // 1 - cos, exact for narrow cones, cl/light_sample.h); cos of the falloff start (w). disk: unit
+  // tangent t2 = n x t1 (xyz), w unused.
   float4 e2;
-  float4 n;        // quad/triangle: unit normal of the emitting face (xyz), area (w)
+  float4 n;        // quad/triangle/disk: unit normal of the emitting face (xyz), area (w)
   float4 emission; // rgb: intensity (point/spot) or radiance (area lights)
   int type;
   int flags;
@@ -52,15 +57,16 @@ typedef struct Material {
 } Material;
 
 // ---------------------------------------------------------------- geometry / BVH
-// A primitive is a triangle or a sphere. Vertices are stored with the primitive so the intersect
-// kernel reads one contiguous record.
+// A primitive is a triangle, a sphere or a disk. Vertices are stored with the primitive so the
+// intersect kernel reads one contiguous record.
 #define PRIM_TRIANGLE 0
 #define PRIM_SPHERE 1
+#define PRIM_DISK 2
 
 typedef struct Primitive {
-  float4 v0; // triangle: vertex 0 (xyz). sphere: centre (xyz), radius (w).
-  float4 e1; // triangle: v1 - v0. sphere: unused.
-  float4 e2; // triangle: v2 - v0. sphere: unused.
+  float4 v0; // triangle: vertex 0 (xyz). sphere, disk: centre (xyz), radius (w).
+  float4 e1; // triangle: v1 - v0. disk: unit normal (xyz). sphere: unused.
+  float4 e2; // triangle: v2 - v0. sphere, disk: unused.
   int type;
   int material; // index into materials
   int light;    // index of the light this primitive shows, or -1

@@ -223,7 +223,7 @@ WEIRD_STRINGS = [
 WEIRD_RAW = [b"\xff\xfe", b"a\nb", b"\xc3", b"a\x00b", b"\xed\xa0\x80", b"\x1b[2J", b"a\tb"]
 
 ENUMS = [
-    "point", "spot", "sphere", "quad", "triangle", "obj", "box", "grid", "random_box", "spiral",
+    "point", "spot", "sphere", "quad", "triangle", "disk", "obj", "box", "grid", "random_box", "spiral",
     "mesh_surface", "diffuse", "conductor", "plastic", "gold", "silver", "Gold", "aluminum",
     "uniform", "power", "tree", "tree-split", "exhaustive", "Tree",
     "tree_split", "tree-split ", "POINT",
@@ -237,7 +237,7 @@ KNOWN_KEYS = [
     "axis", "degrees", "translate", "intensity", "direction", "cone_angle", "falloff_start",
     "center", "radius", "radiance", "v0", "v1", "v2", "light", "count", "variation", "instance",
     "origin", "nx", "ny", "inner_radius", "turns", "height", "shape", "offset", "align_to_normal",
-    "color", "roughness", "metal", "eta", "k", "specular", "ior",
+    "color", "roughness", "metal", "eta", "k", "specular", "ior", "normal",
 ]
 
 PATH_VALUES = ["", ".", "/", "/dev/null", "/dev/zero", "/etc/passwd", "missing.obj",

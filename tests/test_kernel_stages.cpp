@@ -29,8 +29,9 @@ using namespace canopy;
 
 namespace {
 
-// A box room lit by every light type: point, spot, sphere, quad, triangle, an emissive quad
-// shape (mesh-light triangles) and 300 random points, so the light tree has several levels.
+// A box room lit by every light type: point, spot, sphere, quad, triangle, disk (one-sided on the
+// ceiling, two-sided in view of the camera), an emissive quad shape (mesh-light triangles) and
+// 300 random points, so the light tree has several levels.
 const char* kSceneJson = R"({
   "camera": { "position": [0, 1.5, 5], "look_at": [0, 1, 0], "up": [0, 1, 0], "fov": 50 },
   "film": { "width": 16, "height": 12 },
@@ -49,7 +50,10 @@ const char* kSceneJson = R"({
     { "type": "sphere", "center": [2, 0.3, 1], "radius": 0.3, "radiance": [8, 6, 3] },
     { "type": "quad", "corner": [-1, 2.95, 1], "edge1": [2, 0, 0], "edge2": [0, 0, 0.5], "radiance": 3 },
     { "type": "triangle", "v0": [-2.5, 0.01, -2.5], "v1": [-1.5, 0.01, -2.5], "v2": [-2.5, 0.01, -1.5],
-      "radiance": [0, 0, 10], "two_sided": true }
+      "radiance": [0, 0, 10], "two_sided": true },
+    { "type": "disk", "center": [1.5, 2.9, -1], "normal": [0, -1, 0], "radius": 0.4, "radiance": 5 },
+    { "type": "disk", "center": [-1.2, 1.2, 0.5], "normal": [1, 0.3, 0.8], "radius": 0.3,
+      "radiance": [6, 2, 2], "two_sided": true }
   ],
   "light_sets": [
     { "type": "random_box", "min": [-2.5, 2.0, -2.5], "max": [2.5, 2.8, 2.5], "count": 300, "seed": 3,

@@ -19,9 +19,14 @@ namespace {
 using ld = long double;
 
 // Largest dot(n, P - x) over the emitter's vertices (exact enough in long double): > 0 iff the
-// one-sided emitter sends light to P (a linear function is largest at a vertex).
+// one-sided emitter sends light to P (a linear function is largest at a vertex). A disk emits
+// towards P iff dot(n, P - centre) > 0 (cl/light_sample.h): its distance is that of the centre.
 ld front_distance(const Light& l, float3 P) {
   const ld n[3] = {l.n.x, l.n.y, l.n.z};
+  if (l.type == LIGHT_DISK) {
+    ld s = n[0] * (ld(P.x) - l.p.x) + n[1] * (ld(P.y) - l.p.y) + n[2] * (ld(P.z) - l.p.z);
+    return s / std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  }
   const ld p[3] = {l.p.x, l.p.y, l.p.z}, e1[3] = {l.e1.x, l.e1.y, l.e1.z},
            e2[3] = {l.e2.x, l.e2.y, l.e2.z}, q[3] = {P.x, P.y, P.z};
   ld best = -INFINITY;
@@ -43,6 +48,17 @@ std::vector<Light> quad_grid(float3 origin, float3 u, float3 v, int nx, float ce
     for (int j = 0; j < nx; ++j)
       lights.push_back(make_quad_light(origin + u * (cell * float(i)) + v * (cell * float(j)),
                                        u * (0.6f * cell), v * (0.6f * cell), make_float3(1, 1, 1)));
+  return lights;
+}
+
+// The same grid of one-sided disks (radius 0.3 cell), facing cross(u, v); every fifth two-sided.
+std::vector<Light> disk_grid(float3 origin, float3 u, float3 v, int nx, float cell) {
+  std::vector<Light> lights;
+  float3 n = cross(u, v);
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < nx; ++j)
+      lights.push_back(make_disk_light(origin + u * (cell * float(i)) + v * (cell * float(j)), n,
+                                       0.3f * cell, make_float3(1, 1, 1), (i + j) % 5 == 0));
   return lights;
 }
 
@@ -102,7 +118,8 @@ int check_conservative(const LightTree& t, const std::vector<Light>& lights,
     for (int l : ln.lights) {
       const Light& x = lights[size_t(l)];
       const bool one_sided =
-          (x.type == LIGHT_QUAD || x.type == LIGHT_TRIANGLE) && !(x.flags & LIGHT_FLAG_TWO_SIDED);
+          (x.type == LIGHT_QUAD || x.type == LIGHT_TRIANGLE || x.type == LIGHT_DISK) &&
+          !(x.flags & LIGHT_FLAG_TWO_SIDED);
       // points and two-sided quads reach every P (N = 0)
       EXPECT_TRUE(one_sided && front_distance(x, P) <= 0.0L)
           << "culled a light that reaches P: light " << l << " code " << ln.code << " lane "
@@ -126,17 +143,19 @@ TEST(LightTreeCull, LanesAreZeroOnlyWhereNoEmitterReachesP) {
   // Coplanar grids (node lanes get half-space bounds) in random orientations and offsets, random
   // one-sided triangles (leaf records only), and a mixed set with point lights and two-sided
   // quads (no bound may apply to their lanes). 400 points per set near the planes, both sides.
+  // Sets 6 and 7: coplanar grids of one- and two-sided disks.
   LtRng r = lt_rng_make(7, 1);
   int zeros = 0, points = 0;
-  for (int set = 0; set < 6; ++set) {
-    Frame f = random_frame(r, set < 3 ? 2.0f : 300.0f);
-    std::vector<Light> lights = quad_grid(f.o, f.u, f.v, 12, 0.1f);
+  for (int set = 0; set < 8; ++set) {
+    Frame f = random_frame(r, set < 3 || set == 6 ? 2.0f : 300.0f);
+    std::vector<Light> lights =
+        set < 6 ? quad_grid(f.o, f.u, f.v, 12, 0.1f) : disk_grid(f.o, f.u, f.v, 12, 0.1f);
     if (set % 3 == 1) {
       for (Light& l : random_triangle_lights(200, 11 + set, 1.2f)) {
         l.p = f4_from3(xyz_of(l.p) + f.o, l.p.w);
         lights.push_back(l);
       }
-    } else if (set % 3 == 2) {
+    } else if (set % 3 == 2 && set < 6) {
       for (int i = 0; i < 30; ++i) {
         lights.push_back(make_point_light(f.o + random_unit(r), make_float3(1, 1, 1)));
         lights.push_back(make_quad_light(f.o + random_unit(r), f.u * 0.05f, f.v * 0.05f,
@@ -159,14 +178,16 @@ TEST(LightTreeCull, OneSidedEmitterIsZeroBehindItsPlaneAndPositiveInFront) {
   // One quad or triangle (a leaf of one emitter; the root lane bounds it too), random orientation,
   // size and offset. P behind the plane by more than 2^-12 |P - c| + plane_h: the emitter record
   // and the root lane give exactly 0; P strictly in front (exact test): both > 0.
+  // Iterations from 4000 on use a one-sided disk of radius `size`.
   LtRng r = lt_rng_make(8, 2);
-  for (int i = 0; i < 4000; ++i) {
+  for (int i = 0; i < 6000; ++i) {
     Frame f = random_frame(r, std::pow(10.0f, 3.0f * lt_rng_next(&r) - 1.0f));
     float size = std::pow(10.0f, 4.0f * lt_rng_next(&r) - 3.0f);
     Light l =
-        i % 2 ? make_quad_light(f.o, f.u * size, f.v * (0.7f * size), make_float3(1, 1, 1))
-              : make_triangle_light(f.o, f.o + f.u * size, f.o + (f.u * 0.3f + f.v * 0.8f) * size,
-                                    make_float3(1, 1, 1));
+        i >= 4000 ? make_disk_light(f.o, f.n, size, make_float3(1, 1, 1))
+        : i % 2   ? make_quad_light(f.o, f.u * size, f.v * (0.7f * size), make_float3(1, 1, 1))
+                : make_triangle_light(f.o, f.o + f.u * size, f.o + (f.u * 0.3f + f.v * 0.8f) * size,
+                                      make_float3(1, 1, 1));
     std::vector<Light> lights = {l};
     LightTree t = build_light_tree(lights);
     LtTree view = t.view(lights.data());
@@ -185,9 +206,12 @@ TEST(LightTreeCull, OneSidedEmitterIsZeroBehindItsPlaneAndPositiveInFront) {
       // r); the root lane's adds the axis tilt over the emitter
       // (<= 2 * 2^-12 r) and the 16-bit offset (2^-14 r)
       const ld dist = std::sqrt(ld(dot_d(d, d))), r_e = sp.w;
-      const ld norm1 = std::fabs(l.p.x) + std::fabs(l.p.y) + std::fabs(l.p.z) + std::fabs(l.e1.x) +
-                       std::fabs(l.e1.y) + std::fabs(l.e1.z) + std::fabs(l.e2.x) +
-                       std::fabs(l.e2.y) + std::fabs(l.e2.z);
+      // (a disk: |centre| + 2r per axis in place of |p| + |e1| + |e2|)
+      const ld norm1 = l.type == LIGHT_DISK
+                           ? std::fabs(l.p.x) + std::fabs(l.p.y) + std::fabs(l.p.z) + 6.0L * l.p.w
+                           : std::fabs(l.p.x) + std::fabs(l.p.y) + std::fabs(l.p.z) +
+                                 std::fabs(l.e1.x) + std::fabs(l.e1.y) + std::fabs(l.e1.z) +
+                                 std::fabs(l.e2.x) + std::fabs(l.e2.y) + std::fabs(l.e2.z);
       const ld band = std::ldexp(dist, -12) + std::ldexp(dist, -14) + std::ldexp(dist, -20) +
                       std::ldexp(norm1, -20) + std::ldexp(r_e, -20);
       const ld root_band = band + std::ldexp(r_e, -11) + std::ldexp(r_e, -14);

@@ -505,7 +505,10 @@ TEST(LightTreeSampling, SplitMeasureOfTreeNodesInvariantToScale) {
         float m = lt_split_measure(x.P, sp, cv2);
         float3 dv = x.P - xyz_of(sp);
         double d = std::sqrt(dot_d(dv, dv));
-        if (std::fabs(d - sp.w) < 1e-3 * sp.w) continue; // on the sphere: a = d - r ill-conditioned
+        // On the sphere a = d - r is ill-conditioned: scaling rounds P, the centre and r, so a
+        // carries an absolute error of a few ulps of |P| + |c| + r, not of r alone.
+        const double mag = std::sqrt(dot_d(x.P, x.P)) + std::sqrt(dot_d(xyz_of(sp), xyz_of(sp)));
+        if (std::fabs(d - sp.w) < 1e-3 * (sp.w + mag)) continue;
         for (float s : {1e-3f, 1e3f}) {
           float ms = lt_split_measure(x.P * s, sp * s, cv2);
           ASSERT_NEAR(ms, m, 1e-5f * std::fmax(m, 1e-2f) + 1e-7f);

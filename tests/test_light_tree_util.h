@@ -43,6 +43,15 @@ inline std::vector<float3> light_points(const Light& l) {
     for (float u : {0.02f, 0.33f, 0.96f})
       for (float v : {0.02f, 0.33f})
         pts.push_back(p + a * u + b * (v * (1.0f - u)));
+  } else if (l.type == LIGHT_DISK) {
+    // the centre (the middle entry: contribution()'s point) and a ring at 0.98 r
+    float3 a = xyz_of(l.e1), b = xyz_of(l.e2);
+    float r = 0.98f * l.p.w;
+    for (int k = 0; k < 8; ++k) {
+      if (k == 4) pts.push_back(p);
+      float phi = float(k) * 0.25f * M_PI_F;
+      pts.push_back(p + a * (r * std::cos(phi)) + b * (r * std::sin(phi)));
+    }
   } else {
     pts.push_back(p);
   }
@@ -67,7 +76,7 @@ inline double contribution(const Light& l, float3 P, float3 N) {
   if (l.type == LIGHT_SPOT) {
     double c = -(ux * l.e1.x + uy * l.e1.y + uz * l.e1.z);
     cos_l = c >= l.e1.w ? 1.0 : 0.0;
-  } else if (l.type == LIGHT_QUAD || l.type == LIGHT_TRIANGLE) {
+  } else if (l.type == LIGHT_QUAD || l.type == LIGHT_TRIANGLE || l.type == LIGHT_DISK) {
     double c = -(ux * b.cone.axis.x + uy * b.cone.axis.y + uz * b.cone.axis.z);
     cos_l = (l.flags & LIGHT_FLAG_TWO_SIDED) ? std::fabs(c) : std::max(0.0, c);
   }
@@ -89,7 +98,7 @@ inline bool clearly_contributes(const Light& l, float3 P, float3 N) {
     if (l.type == LIGHT_SPOT) {
       double c = -(ux * l.e1.x + uy * l.e1.y + uz * l.e1.z);
       cos_l = c - l.e1.w; // inside the aperture by a margin
-    } else if (l.type == LIGHT_QUAD || l.type == LIGHT_TRIANGLE) {
+    } else if (l.type == LIGHT_QUAD || l.type == LIGHT_TRIANGLE || l.type == LIGHT_DISK) {
       double c = -(ux * b.cone.axis.x + uy * b.cone.axis.y + uz * b.cone.axis.z);
       cos_l = (l.flags & LIGHT_FLAG_TWO_SIDED) ? std::fabs(c) : c;
     }

@@ -211,6 +211,17 @@ namespace {
 // for a sphere entirely above the horizon. Evaluated in double.
 float3 area_light_irradiance(const Light& l, float3 x) {
   float3 L = xyz_of(l.emission);
+  if (l.type == LIGHT_DISK) {
+    // A disk parallel to the plane (normal -z, or +z two-sided), radius r, height h above x and
+    // horizontal offset a from x: the view factor of a differential area to a parallel disk,
+    // F = (1 - (a^2 + h^2 - r^2) / sqrt((a^2 + h^2 + r^2)^2 - 4 a^2 r^2)) / 2 (Siegel & Howell,
+    // configuration factor B-2 family), and E = pi L F; on axis (a = 0), pi L r^2 / (r^2 + h^2).
+    double ax = double(l.p.x) - x.x, ay = double(l.p.y) - x.y, h = double(l.p.z) - x.z;
+    double a2 = ax * ax + ay * ay, r2 = double(l.p.w) * l.p.w, h2 = h * h;
+    double s = a2 + h2 + r2;
+    double F = 0.5 * (1.0 - (a2 + h2 - r2) / std::sqrt(s * s - 4.0 * a2 * r2));
+    return L * float(M_PI * F);
+  }
   if (l.type == LIGHT_SPHERE) {
     double tx = l.p.x - x.x, ty = l.p.y - x.y, tz = l.p.z - x.z;
     double d2 = tx * tx + ty * ty + tz * tz, r = l.p.w;
@@ -270,6 +281,22 @@ Light triangle_light() {
   return l;
 }
 
+// Parallel to the plane: one-sided facing it, and two-sided facing away (it lights the plane with
+// its back face).
+Light disk_light(bool two_sided) {
+  Light l{};
+  l.type = LIGHT_DISK;
+  l.flags = two_sided ? LIGHT_FLAG_TWO_SIDED : 0;
+  float r = two_sided ? 0.35f : 0.5f;
+  l.p = two_sided ? make_float4(-0.3f, 0.4f, 0.7f, r) : make_float4(0.2f, -0.1f, 1.1f, r);
+  l.e1 = make_float4(1, 0, 0, 0);
+  l.e2 = two_sided ? make_float4(0, 1, 0, 0) : make_float4(0, -1, 0, 0); // e1 x e2 = n
+  l.n = make_float4(0, 0, two_sided ? 1.0f : -1.0f, float(M_PI * double(r) * r));
+  l.emission = two_sided ? make_float4(2.0f, 4.0f, 3.0f, 0) : make_float4(3.0f, 2.0f, 1.0f, 0);
+  l.prim = -1;
+  return l;
+}
+
 Light sphere_light() {
   Light l{};
   l.type = LIGHT_SPHERE;
@@ -285,7 +312,10 @@ class AreaLightMis : public ::testing::TestWithParam<std::tuple<int, int>> {};
 
 TEST_P(AreaLightMis, PixelMeansMatchTheIrradianceIntegral) {
   const int which = std::get<0>(GetParam()), max_depth = std::get<1>(GetParam());
-  Light light = which == 0 ? quad_light() : which == 1 ? triangle_light() : sphere_light();
+  Light light = which == 0   ? quad_light()
+                : which == 1 ? triangle_light()
+                : which == 2 ? sphere_light()
+                             : disk_light(which == 4);
   Scene scene = make_area_light_scene(light, max_depth);
   ClRuntime rt;
   RendererOptions opt;
@@ -365,5 +395,7 @@ TEST_P(AreaLightMis, PixelMeansMatchTheIrradianceIntegral) {
   EXPECT_LT(total_bound, 0.02 * total_ref); // tight enough to catch a wrong MIS weight or pdf
 }
 
-INSTANTIATE_TEST_SUITE_P(QuadTriangleSphere, AreaLightMis,
-                         ::testing::Combine(::testing::Values(0, 1, 2), ::testing::Values(1, 2)));
+// 3: a one-sided disk, 4: a two-sided disk lighting the plane with its back face.
+INSTANTIATE_TEST_SUITE_P(QuadTriangleSphereDisk, AreaLightMis,
+                         ::testing::Combine(::testing::Values(0, 1, 2, 3, 4),
+                                            ::testing::Values(1, 2)));

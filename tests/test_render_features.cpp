@@ -1,5 +1,6 @@
 // Kernels compiled for the scene (DESIGN §7) render exactly what kernels with every feature
 // compiled in render, and a render is bit-identical from run to run and for any wave size.
+#include "lighttree/synthetic_lights.h"
 #include "render/renderer.h"
 
 #include <gtest/gtest.h>
@@ -57,6 +58,29 @@ TEST_P(RenderFeatures, MinimalFeatureSetRendersTheSameImageAsEveryFeature) {
   EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_SPHERE=0"), std::string::npos) << minimal_opts;
   EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_POINT=0"), std::string::npos) << minimal_opts;
   EXPECT_NE(all_opts.find("-DHAS_LIGHT_SPHERE=1"), std::string::npos) << all_opts;
+  // no disk code for a scene without disks
+  EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_DISK=0"), std::string::npos) << minimal_opts;
+  EXPECT_NE(minimal_opts.find("-DHAS_PRIM_DISK=0"), std::string::npos) << minimal_opts;
+  EXPECT_NE(all_opts.find("-DHAS_LIGHT_DISK=1 -DHAS_PRIM_SPHERE=1 -DHAS_PRIM_DISK=1"),
+            std::string::npos)
+      << all_opts;
+  expect_identical(minimal, all);
+}
+
+TEST_P(RenderFeatures, SceneWithDisksRendersTheSameImageWithEveryFeature) {
+  // The default scene plus a one-sided disk on the ceiling and a two-sided one in view: the
+  // minimal build has the disk light and primitive but no sphere or point code.
+  Scene scene = small_default_scene();
+  scene.lights.push_back(make_disk_light(make_float3(0.5f, 1.95f, 0.3f), make_float3(0, -1, 0),
+                                         0.3f, make_float3(4, 4, 3)));
+  scene.lights.push_back(make_disk_light(make_float3(-0.6f, 1.0f, 0.2f), make_float3(0.4f, 0.2f, 1),
+                                         0.25f, make_float3(1, 3, 2), true));
+  std::string minimal_opts;
+  Film minimal = render(scene, GetParam(), false, 1 << 18, &minimal_opts);
+  Film all = render(scene, GetParam(), true, 1 << 18);
+  EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_DISK=1"), std::string::npos) << minimal_opts;
+  EXPECT_NE(minimal_opts.find("-DHAS_PRIM_DISK=1"), std::string::npos) << minimal_opts;
+  EXPECT_NE(minimal_opts.find("-DHAS_PRIM_SPHERE=0"), std::string::npos) << minimal_opts;
   expect_identical(minimal, all);
 }
 

@@ -80,7 +80,7 @@ TEST(SceneErrors, KeyOfAnotherLightType) {
 TEST(SceneErrors, UnknownLightType) {
   EXPECT_EQ(light_error(R"({"type": "laser", "intensity": 1})"),
             "scene.json: lights[0].type: unknown value \"laser\" (expected one of: point, spot, "
-            "sphere, quad, triangle)");
+            "sphere, quad, triangle, disk)");
 }
 
 TEST(SceneErrors, UnknownShapeType) {
@@ -646,11 +646,54 @@ TEST(SceneErrors, MeshSurfaceShapeIndexOutOfRange) {
             "scene.json: light_sets[0].shape: must be in [0, 0]");
 }
 
+TEST(SceneErrors, DiskLight) {
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, -1, 0],
+               "radius": 0, "radiance": 1})"),
+            "scene.json: lights[0].radius: must be > 0");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, -1, 0],
+               "radius": -2, "radiance": 1})"),
+            "scene.json: lights[0].radius: must be > 0");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, -1, 0],
+               "radius": 1e39, "radiance": 1})"),
+            "scene.json: lights[0].radius: must be finite");
+  // pi r^2 underflows to 0
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, -1, 0],
+               "radius": 1e-30, "radiance": 1})"),
+            "scene.json: lights[0].radius: area pi r^2 must be a positive finite float");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, 0, 0],
+               "radius": 1, "radiance": 1})"),
+            "scene.json: lights[0].normal: must not be the zero vector");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, 1e39, 0],
+               "radius": 1, "radiance": 1})"),
+            "scene.json: lights[0].normal[1]: must be finite");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, 1, 0],
+               "radius": 1, "radiance": [1, -1, 1]})"),
+            "scene.json: lights[0].radiance[1]: must be >= 0");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, 1, 0],
+               "radius": 1, "radiance": 1e39})"),
+            "scene.json: lights[0].radiance: must be finite");
+  EXPECT_EQ(light_error(R"({"type": "disk", "normal": [0, 1, 0], "radius": 1, "radiance": 1})"),
+            "scene.json: lights[0].center: required key is missing");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "radius": 1, "radiance": 1})"),
+            "scene.json: lights[0].normal: required key is missing");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, 1, 0],
+               "radius": 1, "radiance": 1, "edge1": [1, 0, 0]})"),
+            "scene.json: lights[0].edge1: unknown key");
+  EXPECT_EQ(light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, 1, 0],
+               "radius": 1, "radiance": 1, "two_sided": 1})"),
+            "scene.json: lights[0].two_sided: must be true or false");
+  // its bounds leave the coordinate range
+  std::string e = light_error(R"({"type": "disk", "center": [0, 1, 0], "normal": [0, 1, 0],
+               "radius": 2e18, "radiance": 1})");
+  EXPECT_EQ(e.rfind("scene.json: lights[0]: its bounds ", 0), 0u) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos);
+}
+
 TEST(SceneErrors, AlignToNormalNeedsSpot) {
   EXPECT_EQ(error_of(scene_with(R"("shapes": [{"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}],
                "light_sets": [{"type": "mesh_surface", "shape": 0, "count": 10,
                "align_to_normal": true, "light": {"type": "point", "intensity": 1}}])")),
-            "scene.json: light_sets[0].align_to_normal: applies to spot lights only");
+            "scene.json: light_sets[0].align_to_normal: applies to spot and disk lights only");
 }
 
 TEST(SceneErrors, VariationScaleZero) {

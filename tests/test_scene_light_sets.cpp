@@ -66,6 +66,39 @@ TEST(SceneLightSets, QuadTemplateCentredOnSite) {
   EXPECT_NEAR(l.n.w, 0.04f, 1e-7f);
 }
 
+TEST(SceneLightSets, DiskTemplate) {
+  // grid sites move the centre (an offset from the site); normal, radius and flags come from the
+  // template; on a mesh surface with align_to_normal the disk faces along the surface normal.
+  Scene s = with_sets(R"([{"type": "grid", "origin": [0, 2, 0], "edge1": [1, 0, 0],
+      "edge2": [0, 0, 1], "nx": 2, "ny": 2,
+      "light": {"type": "disk", "center": [0, -0.1, 0], "normal": [0, -1, 0], "radius": 0.1,
+                "radiance": 1, "two_sided": true}},
+      {"type": "mesh_surface", "shape": 0, "count": 50, "offset": 0.01, "align_to_normal": true,
+      "light": {"type": "disk", "normal": [1, 0, 0], "radius": 0.02, "radiance": 2}}])",
+                      R"("shapes": [{"type": "box", "min": [5, 5, 5], "max": [6, 6, 6]}])");
+  ASSERT_EQ(s.lights.size(), 54u);
+  for (size_t i = 0; i < 4; ++i) {
+    const Light& l = s.lights[i];
+    EXPECT_EQ(l.type, LIGHT_DISK);
+    EXPECT_EQ(l.flags, LIGHT_FLAG_TWO_SIDED);
+    EXPECT_FLOAT_EQ(l.p.y, 1.9f);
+    EXPECT_FLOAT_EQ(l.p.w, 0.1f);
+    EXPECT_FLOAT_EQ(l.n.y, -1.0f);
+  }
+  EXPECT_FLOAT_EQ(s.lights[3].p.x, 0.75f); // the last of the 2 x 2 cell centres
+  for (size_t i = 4; i < 54; ++i) {
+    const Light& l = s.lights[i];
+    EXPECT_EQ(l.type, LIGHT_DISK);
+    EXPECT_FLOAT_EQ(l.p.w, 0.02f);
+    float3 c = xyz_of(l.p) - make_float3(5.5f, 5.5f, 5.5f);
+    float3 n = xyz_of(l.n);
+    EXPECT_NEAR(length(n), 1.0f, 1e-6f);
+    EXPECT_NEAR(dot(c, n), 0.51f, 1e-5f); // outward face normal, offset 0.01 along it
+    EXPECT_NEAR(dot(xyz_of(l.e1), n), 0.0f, 1e-6f);
+    EXPECT_NEAR(dot(xyz_of(l.e2), n), 0.0f, 1e-6f);
+  }
+}
+
 TEST(SceneLightSets, RandomBoxBoundsAndDeterminism) {
   const char* set = R"([{"type": "random_box", "min": [-1, 2, 3], "max": [1, 2.5, 7],
       "count": 5000, "seed": 42, "light": {"type": "sphere", "radius": 0.01, "radiance": 1}}])";

@@ -245,6 +245,43 @@ TEST(SceneLoader, PointAndSpot) {
   EXPECT_NEAR(s.lights[2].e2.w, std::cos(40 * kDeg), 1e-6f);
 }
 
+TEST(SceneLoader, Disk) {
+  Scene s = load_str(scene_with("", R"([
+      {"type": "disk", "center": [1, 2, 3], "normal": [0, -3, 0], "radius": 0.5,
+       "radiance": [1, 2, 3]},
+      {"type": "disk", "center": [0, 1, 0], "normal": [1, 1e-30, 2], "radius": 2, "radiance": 4,
+       "two_sided": true}])"));
+  ASSERT_EQ(s.lights.size(), 2u);
+  const Light& d = s.lights[0];
+  EXPECT_EQ(d.type, LIGHT_DISK);
+  EXPECT_EQ(d.prim, -1);
+  EXPECT_EQ(d.flags, 0);
+  EXPECT_FLOAT_EQ(d.p.x, 1);
+  EXPECT_FLOAT_EQ(d.p.z, 3);
+  EXPECT_FLOAT_EQ(d.p.w, 0.5f);               // radius
+  EXPECT_FLOAT_EQ(d.n.y, -1);                 // unit normal
+  EXPECT_FLOAT_EQ(d.n.w, float(M_PI * 0.25)); // area
+  EXPECT_FLOAT_EQ(d.emission.z, 3);
+  for (const Light& l : s.lights) {
+    // e1, e2: an orthonormal tangent frame with e1 x e2 = n
+    float3 t1 = xyz_of(l.e1), t2 = xyz_of(l.e2), n = xyz_of(l.n);
+    EXPECT_NEAR(length(t1), 1.0f, 1e-6f);
+    EXPECT_NEAR(length(t2), 1.0f, 1e-6f);
+    EXPECT_NEAR(length(n), 1.0f, 1e-6f);
+    EXPECT_NEAR(dot(t1, n), 0.0f, 1e-6f);
+    EXPECT_NEAR(dot(t2, n), 0.0f, 1e-6f);
+    EXPECT_NEAR(dot(t1, t2), 0.0f, 1e-6f);
+    float3 c = cross(t1, t2);
+    EXPECT_NEAR(dot(c, n), 1.0f, 1e-6f);
+  }
+  const Light& d2 = s.lights[1];
+  EXPECT_EQ(d2.flags, LIGHT_FLAG_TWO_SIDED);
+  EXPECT_NEAR(d2.n.x, 1.0 / std::sqrt(5.0), 1e-7);
+  EXPECT_NEAR(d2.n.z, 2.0 / std::sqrt(5.0), 1e-7);
+  EXPECT_FLOAT_EQ(d2.n.w, float(M_PI * 4.0));
+  EXPECT_EQ(s.triangle_count(), 0u);
+}
+
 TEST(SceneLoader, SphereQuadTriangle) {
   Scene s = load_str(scene_with("", R"([
       {"type": "sphere", "center": [1, 2, 3], "radius": 0.5, "radiance": [1, 2, 3]},

@@ -32,6 +32,20 @@ void primitive_bounds(const Primitive& p, float3& lo, float3& hi) {
     hi = v0 + make_float3(r, r, r);
     return;
   }
+  if (p.type == PRIM_DISK) {
+    // A circle of radius r in the plane with unit normal n spans r sqrt(1 - n_i^2) along axis i;
+    // padded (2^-20 of r and of |centre|) so rounding cannot put a hit point outside the box.
+    float r = p.v0.w;
+    float3 n = xyz_of(p.e1);
+    float3 ext = make_float3(std::sqrt(std::max(0.0f, 1.0f - n.x * n.x)),
+                             std::sqrt(std::max(0.0f, 1.0f - n.y * n.y)),
+                             std::sqrt(std::max(0.0f, 1.0f - n.z * n.z))) *
+                     (r * 1.000001f) +
+                 fabs(v0) * 9.5367432e-07f;
+    lo = v0 - ext;
+    hi = v0 + ext;
+    return;
+  }
   float3 v1 = v0 + xyz_of(p.e1), v2 = v0 + xyz_of(p.e2);
   lo = fmin(v0, fmin(v1, v2));
   hi = fmax(v0, fmax(v1, v2));
@@ -183,6 +197,15 @@ std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& mat
       s.normals = -1;
       l.prim = int(prims.size());
       prims.push_back(s);
+    } else if (l.type == LIGHT_DISK) {
+      Primitive dk{};
+      dk.v0 = l.p;
+      dk.e1 = f4_from3(xyz_of(l.n), 0.0f);
+      dk.type = PRIM_DISK;
+      dk.material = black;
+      dk.light = int(i);
+      l.prim = int(prims.size());
+      prims.push_back(dk);
     } else if (l.type == LIGHT_QUAD) {
       l.prim = int(prims.size());
       prims.push_back(make_triangle(p, p + e1, p + e1 + e2, black, int(i)));

@@ -543,7 +543,30 @@ namespace {
 // 2^-20 (|p| + |e1| + |e2|) in the 1-norm, covers the rounding of the sample points (gamma(6) of
 // the same sum, cl/light_sample.h), of the geometry triangles' vertices, of n's normalisation
 // (L.n's direction to ~1e-7 times the emitter's radius) and of this double evaluation.
+// A one-sided disk emits towards P iff dot(n, P - centre) > 0 (cl/light_sample.h tests the centre,
+// whatever the sampled or hit point), so h is dot(n, c - centre) plus the same margin, with
+// |centre| + 2r per axis in place of |p| + |e1| + |e2|.
+double disk_plane_offset(const Light& l, const EmitterBounds& b) {
+  const float3 n = b.cone.axis;
+  const float4 c = lt_sphere_of_box(b.bmin, b.bmax);
+  const double cc[3] = {c.x, c.y, c.z}, p[3] = {l.p.x, l.p.y, l.p.z}, nn[3] = {n.x, n.y, n.z};
+  const double r = std::fabs(double(l.p.w));
+  double h = 0, norm1 = 0;
+  for (int k = 0; k < 3; ++k) {
+    h += nn[k] * (cc[k] - p[k]);
+    norm1 += std::fabs(p[k]) + 2.0 * r;
+  }
+  h += std::ldexp(norm1, -20);
+  return std::isfinite(h) ? h : NAN;
+}
+
 double plane_offset(const Light& l, const EmitterBounds& b) {
+  if (l.type == LIGHT_DISK && !(l.flags & LIGHT_FLAG_TWO_SIDED) && b.cos_o >= 1.0f) {
+    const double nl =
+        std::sqrt(double(l.n.x) * l.n.x + double(l.n.y) * l.n.y + double(l.n.z) * l.n.z);
+    if (!(nl > 0) || !std::isfinite(nl)) return NAN;
+    return disk_plane_offset(l, b);
+  }
   if ((l.type != LIGHT_QUAD && l.type != LIGHT_TRIANGLE) || (l.flags & LIGHT_FLAG_TWO_SIDED) ||
       b.cos_o < 1.0f)
     return NAN;
@@ -594,6 +617,8 @@ EmitterBounds emitter_bounds(const Light& light) {
            cz = e1[0] * e2[1] - e1[1] * e2[0];
     double area = std::sqrt(cx * cx + cy * cy + cz * cz);
     energy = lum * (light.type == LIGHT_QUAD ? area : 0.5 * area);
+  } else if (light.type == LIGHT_DISK) {
+    energy = lum * M_PI * double(light.p.w) * double(light.p.w);
   }
   b.energy = (energy > 0 && std::isfinite(energy)) ? energy : 0.0;
   b.plane_h = plane_offset(light, b);

@@ -2,6 +2,7 @@
 
 #include "light_tree/cone.h" // lt_any_perpendicular
 #include "light_tree/rng.h"
+#include "shading.h"
 
 #include <cmath>
 
@@ -68,6 +69,18 @@ Light make_triangle_light(float3 v0, float3 v1, float3 v2, float3 radiance, bool
   l.e1 = f4_from3(e1, 0.0f);
   l.e2 = f4_from3(e2, 0.0f);
   l.n = f4_from3(normalize(c), 0.5f * length(c));
+  l.emission = f4_from3(radiance, 0.0f);
+  l.flags = two_sided ? LIGHT_FLAG_TWO_SIDED : 0;
+  return l;
+}
+Light make_disk_light(float3 c, float3 normal, float radius, float3 radiance, bool two_sided) {
+  Light l = blank(LIGHT_DISK);
+  float3 n = normalize(normal), t1, t2;
+  onb_from(n, &t1, &t2);
+  l.p = f4_from3(c, radius);
+  l.e1 = f4_from3(t1, 0.0f);
+  l.e2 = f4_from3(t2, 0.0f);
+  l.n = f4_from3(n, float(M_PI * double(radius) * double(radius)));
   l.emission = f4_from3(radiance, 0.0f);
   l.flags = two_sided ? LIGHT_FLAG_TWO_SIDED : 0;
   return l;
@@ -162,14 +175,24 @@ std::vector<Light> spiral_lights(int n) {
 }
 
 std::vector<Light> mixed_lights(int n, uint32_t seed, float size) {
-  R r(seed, 4);
+  // Every eighth light is a disk drawn from its own stream, so the other lights are the same
+  // sequence (point, spot, sphere, quad, two-sided quad, two triangles) as without disks.
+  R r(seed, 4), rd(seed, 5);
   std::vector<Light> out;
   out.reserve(n);
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0, j = 0; i < n; ++i) {
+    if (i % 8 == 7) {
+      float3 c = make_float3(rd.u(0, size), rd.u(0, size), rd.u(0, size));
+      float s = size * rd.u(0.005f, 0.05f);
+      float3 col = rd.color(0.1f, 5.0f);
+      float3 nrm = rd.unit();
+      out.push_back(make_disk_light(c, nrm, s, col, (i / 8) % 3 == 2)); // a third two-sided
+      continue;
+    }
     float3 c = make_float3(r.u(0, size), r.u(0, size), r.u(0, size));
     float s = size * r.u(0.005f, 0.05f);
     float3 col = r.color(0.1f, 5.0f);
-    switch (i % 7) {
+    switch (j++ % 7) {
     case 0:
       out.push_back(make_point_light(c, col));
       break;
@@ -184,7 +207,7 @@ std::vector<Light> mixed_lights(int n, uint32_t seed, float size) {
     case 3:
     case 4: {
       float3 nrm = r.unit(), t = lt_any_perpendicular(nrm), b = cross(nrm, t);
-      out.push_back(make_quad_light(c, t * s, b * (s * r.u(0.3f, 2.0f)), col, i % 7 == 4));
+      out.push_back(make_quad_light(c, t * s, b * (s * r.u(0.3f, 2.0f)), col, (j - 1) % 7 == 4));
       break;
     }
     default: {

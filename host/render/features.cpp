@@ -24,7 +24,8 @@ const char* light_sampler_name(int kind) {
 KernelFeatures KernelFeatures::all(int light_sampler) {
   KernelFeatures f;
   f.light_point = f.light_spot = f.light_sphere = f.light_quad = f.light_triangle = true;
-  f.prim_sphere = true;
+  f.light_disk = true;
+  f.prim_sphere = f.prim_disk = true;
   f.material_conductor = f.material_plastic = true;
   f.light_sampler = light_sampler;
   return f;
@@ -33,11 +34,12 @@ KernelFeatures KernelFeatures::all(int light_sampler) {
 std::string KernelFeatures::build_options() const {
   return fmt::format("-DCANOPY_FEATURES_SET -DHAS_LIGHT_POINT={} -DHAS_LIGHT_SPOT={} "
                      "-DHAS_LIGHT_SPHERE={} -DHAS_LIGHT_QUAD={} -DHAS_LIGHT_TRIANGLE={} "
-                     "-DHAS_PRIM_SPHERE={} -DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} "
+                     "-DHAS_LIGHT_DISK={} -DHAS_PRIM_SPHERE={} -DHAS_PRIM_DISK={} "
+                     "-DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} "
                      "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={}",
                      int(light_point), int(light_spot), int(light_sphere), int(light_quad),
-                     int(light_triangle), int(prim_sphere), int(material_conductor),
-                     int(material_plastic), light_sampler, int(mis));
+                     int(light_triangle), int(light_disk), int(prim_sphere), int(prim_disk),
+                     int(material_conductor), int(material_plastic), light_sampler, int(mis));
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {
@@ -59,6 +61,9 @@ KernelFeatures scene_features(const Scene& scene, int light_sampler) {
       break;
     case LIGHT_TRIANGLE:
       f.light_triangle = true;
+      break;
+    case LIGHT_DISK:
+      f.light_disk = f.prim_disk = true;
       break;
     default:
       break;

@@ -1,5 +1,5 @@
-// Which kernel features a scene needs (DESIGN §7): light types, sphere primitives, the light
-// sampler. They become -D options so a kernel holds only the code the scene uses.
+// Which kernel features a scene needs (DESIGN §7): light types, sphere and disk primitives, the
+// light sampler. They become -D options so a kernel holds only the code the scene uses.
 #pragma once
 
 #include "scene/scene.h"
@@ -10,8 +10,8 @@ namespace canopy {
 
 struct KernelFeatures {
   bool light_point = false, light_spot = false, light_sphere = false, light_quad = false,
-       light_triangle = false;
-  bool prim_sphere = false;
+       light_triangle = false, light_disk = false;
+  bool prim_sphere = false, prim_disk = false;
   bool material_conductor = false, material_plastic = false;
   int light_sampler = 0; // SAMPLER_* (cl/types.h)
   bool mis = true;       // RendererOptions::mis

@@ -147,6 +147,12 @@ std::string check_light_extent(const Light& l) {
       if (!(e = check_coordinate(q)).empty()) return "its bounds " + e;
     return {};
   }
+  case LIGHT_DISK: {
+    float r = l.p.w;
+    for (float3 q : {p + make_float3(r, r, r), p - make_float3(r, r, r)})
+      if (!(e = check_coordinate(q)).empty()) return "its bounds " + e;
+    return {};
+  }
   case LIGHT_QUAD:
   case LIGHT_TRIANGLE: {
     float3 e1 = xyz_of(l.e1), e2 = xyz_of(l.e2);

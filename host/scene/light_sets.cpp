@@ -153,8 +153,8 @@ void expand_light_set(const JsonValue& v, Builder& b) {
     }
     float offset = o.get_float("offset", 0.0f);
     bool align = o.get_bool("align_to_normal", false);
-    if (align && tmpl.type != LIGHT_SPOT)
-      o.req("align_to_normal").fail("applies to spot lights only");
+    if (align && tmpl.type != LIGHT_SPOT && tmpl.type != LIGHT_DISK)
+      o.req("align_to_normal").fail("applies to spot and disk lights only");
     int64_t count = count_of("count");
     const Scene& s = b.scene;
     size_t t0 = range->first_triangle, t1 = range->end_triangle;
@@ -197,7 +197,11 @@ void expand_light_set(const JsonValue& v, Builder& b) {
   Pcg32 vrng(seed, 0xc010);
   for (size_t i = 0; i < n; ++i) {
     Light l = place(tmpl, sites[i]);
-    if (!normals.empty()) {
+    if (!normals.empty() && l.type == LIGHT_DISK) {
+      // the disk faces along the surface normal
+      if (!finish_disk_light(l, normals[i]))
+        v.fail(fmt::format("light {} (of {}): the surface normal is degenerate", i + 1, n));
+    } else if (!normals.empty()) {
       l.e1.x = normals[i].x;
       l.e1.y = normals[i].y;
       l.e1.z = normals[i].z;

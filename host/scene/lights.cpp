@@ -1,5 +1,7 @@
-// Analytic lights: point, spot, sphere, quad, triangle (docs/scene-format.md, "lights").
+// Analytic lights: point, spot, sphere, quad, triangle, disk (docs/scene-format.md, "lights").
 #include "scene/loader_internal.h"
+
+#include "shading.h"
 
 #include <fmt/format.h>
 
@@ -16,6 +18,24 @@ bool finish_area_light(Light& l) {
   float area = l.type == LIGHT_QUAD ? len : 0.5f * len;
   if (!(area > 0.0f)) return false;
   l.n = f4_from3(n, area);
+  return true;
+}
+
+bool finish_disk_light(Light& l, float3 normal) {
+  // The unit normal in double (a normal given with large components keeps its direction), then
+  // an orthonormal tangent frame around it (cl/shading.h onb_from).
+  double nx = normal.x, ny = normal.y, nz = normal.z;
+  double nl = std::sqrt(nx * nx + ny * ny + nz * nz);
+  if (!(nl > 0.0) || !std::isfinite(nl)) return false;
+  float3 n = make_float3(float(nx / nl), float(ny / nl), float(nz / nl));
+  float3 t1, t2;
+  onb_from(n, &t1, &t2);
+  double r = l.p.w;
+  float area = float(3.14159265358979323846 * r * r);
+  if (!(area > 0.0f) || !std::isfinite(area)) return false;
+  l.n = f4_from3(n, area);
+  l.e1 = f4_from3(t1, 0.0f);
+  l.e2 = f4_from3(t2, 0.0f);
   return true;
 }
 
@@ -48,7 +68,7 @@ float3 vec_or(const JsonObject& o, std::string_view key, bool is_template, float
 
 Light parse_light(const JsonValue& v, bool is_template) {
   auto o = v.as_object();
-  std::string type = o.req("type").as_enum({"point", "spot", "sphere", "quad", "triangle"});
+  std::string type = o.req("type").as_enum({"point", "spot", "sphere", "quad", "triangle", "disk"});
   Light l{};
   l.prim = -1;
   const float3 zero = make_float3(0, 0, 0);
@@ -95,6 +115,18 @@ Light parse_light(const JsonValue& v, bool is_template) {
     l.flags = o.get_bool("two_sided", false) ? LIGHT_FLAG_TWO_SIDED : 0;
     l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
     if (!finish_area_light(l)) o.fail("area must be > 0 (edge1 and edge2 are parallel or zero)");
+  } else if (type == "disk") {
+    o.allow({"type", "center", "normal", "radius", "radiance", "two_sided"});
+    l.type = LIGHT_DISK;
+    // As a template, the disk is centred on the generated site unless a centre offset is given.
+    float3 c = vec_or(o, "center", is_template, zero);
+    float3 normal = o.req("normal").as_vec3_nonzero();
+    float r = o.req("radius").as_float_positive();
+    l.p = f4_from3(c, r);
+    l.flags = o.get_bool("two_sided", false) ? LIGHT_FLAG_TWO_SIDED : 0;
+    l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
+    if (!finish_disk_light(l, normal))
+      o.req("radius").fail("area pi r^2 must be a positive finite float");
   } else { // triangle
     o.allow({"type", "v0", "v1", "v2", "radiance", "two_sided"});
     l.type = LIGHT_TRIANGLE;

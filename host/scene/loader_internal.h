@@ -148,6 +148,10 @@ bool emits(const Light& l);
 Light parse_light(const JsonValue& v, bool is_template);
 // Fills n (unit normal, area in w) of a quad/triangle light; false if the area is zero.
 bool finish_area_light(Light& l);
+// Fills n (unit normal of `normal`, area in w) and the tangent frame e1, e2 of a disk light whose
+// p holds centre and radius; false if the normal cannot be normalised or the area is not a
+// positive finite float.
+bool finish_disk_light(Light& l, float3 normal);
 // A spot's cone fields (cl/types.h) from its half-angles in degrees (start <= cone).
 void set_spot_cone(Light& l, double cone_deg, double start_deg);
 // Light sets (light_sets.cpp): expands one entry of "light_sets".
