@@ -458,6 +458,7 @@ TEST(LightTreeSampling, SplitDecisionsInvariantToSceneScale) {
         x.e2 = x.e2 * size;
         x.n.w *= size * size;
       }
+      if (x.type == LIGHT_DISK) x.n.w *= size * size; // radius in p.w, a unit frame
       // area lights: radiance scaled so the energy (L * A) scales by `energy`
       float k = (x.type == LIGHT_POINT || x.type == LIGHT_SPOT) ? energy : energy / (size * size);
       x.emission = x.emission * k;
