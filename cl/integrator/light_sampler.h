@@ -1,6 +1,7 @@
 // The light-selection techniques behind one interface, shared by the light_pick/shade_surface
 // kernels and the host reference: uniform, power (alias table), tree (Conty Estevez & Kulla 2018
-// Alg. 2), tree with adaptive splitting (Alg. 3) and exhaustive (every light; the reference).
+// Alg. 2), tree with adaptive splitting (Alg. 3), exhaustive (every light; the reference) and bsdf
+// (no light: BSDF sampling only, nothing to pick, pmf 0).
 #ifndef CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 #define CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 
@@ -38,7 +39,7 @@ INLINE SplitItem light_sampler_root(const LightSamplerCtx* ls, int path) {
 INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, float3 N, LtRng* rng,
                               float* pmf) {
   *pmf = 0.0f;
-  if (ls->light_count <= 0) return -1;
+  if (ls->light_count <= 0 || ls->kind == SAMPLER_BSDF) return -1;
   if (ls->kind == SAMPLER_UNIFORM) {
     *pmf = 1.0f / (float)ls->light_count;
     return (int)lt_rng_index(rng, (uint)ls->light_count);
@@ -55,7 +56,7 @@ INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, flo
 // With splitting it is the product of the lane probabilities below the item where splitting
 // stopped (DESIGN §4), recomputed along the light's bit-trail with the same functions.
 INLINE float light_sampler_pmf(const LightSamplerCtx* ls, float3 P, float3 N, int light) {
-  if (ls->light_count <= 0) return 0.0f;
+  if (ls->light_count <= 0 || ls->kind == SAMPLER_BSDF) return 0.0f;
   if (ls->kind == SAMPLER_UNIFORM) return 1.0f / (float)ls->light_count;
   if (ls->kind == SAMPLER_POWER) return ls->power_pmf[light];
   if (ls->kind == SAMPLER_TREE) return lt_pmf_below(&ls->tree, 0, P, N, ls->tree.trails[light]);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string_view>
 
 namespace canopy {
 
@@ -98,6 +99,15 @@ public:
       out.push_back({i, 1.0f});
   }
   float pmf(float3, float3, int) const override { return 1.0f; }
+};
+
+// BSDF sampling only: no light is ever picked (emission is found by BSDF-sampled rays alone).
+class BsdfSampler final : public LightSampler {
+public:
+  explicit BsdfSampler(const std::vector<Light>& lights) : LightSampler(lights) {}
+  const char* name() const override { return "bsdf"; }
+  void sample(float3, float3, Rng&, std::vector<LightPick>&) const override {}
+  float pmf(float3, float3, int) const override { return 0.0f; }
 };
 
 // Tree samplers. If every light has zero energy the tree cannot rank anything: fall back to
@@ -206,8 +216,7 @@ void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float thre
 }
 
 const std::vector<std::string>& light_sampler_names() {
-  static const std::vector<std::string> names = {"uniform", "power", "tree", "tree-split",
-                                                 "exhaustive"};
+  static const std::vector<std::string> names(kLightSamplerNames.begin(), kLightSamplerNames.end());
   return names;
 }
 
@@ -217,13 +226,26 @@ std::unique_ptr<LightSampler> make_light_sampler(const std::string& name,
   if (!(opt.split_threshold >= 0.0f && opt.split_threshold <= 1.0f))
     throw std::invalid_argument("light sampler: split threshold must be in [0, 1]");
   if (opt.max_cut < 1) throw std::invalid_argument("light sampler: max_cut must be >= 1");
-  if (name == "uniform") return std::make_unique<UniformSampler>(lights);
-  if (name == "power") return std::make_unique<PowerSampler>(lights);
-  if (name == "tree") return std::make_unique<TreeSampler>(lights, opt);
-  if (name == "tree-split") return std::make_unique<TreeSplitSampler>(lights, opt);
-  if (name == "exhaustive") return std::make_unique<ExhaustiveSampler>(lights);
-  throw std::invalid_argument("unknown light sampler '" + name +
-                              "' (expected uniform, power, tree, tree-split or exhaustive)");
+  switch (light_sampler_kind(name)) {
+  case SAMPLER_UNIFORM:
+    return std::make_unique<UniformSampler>(lights);
+  case SAMPLER_POWER:
+    return std::make_unique<PowerSampler>(lights);
+  case SAMPLER_TREE:
+    return std::make_unique<TreeSampler>(lights, opt);
+  case SAMPLER_TREE_SPLIT:
+    return std::make_unique<TreeSplitSampler>(lights, opt);
+  case SAMPLER_EXHAUSTIVE:
+    return std::make_unique<ExhaustiveSampler>(lights);
+  case SAMPLER_BSDF:
+    return std::make_unique<BsdfSampler>(lights);
+  default:
+    break;
+  }
+  std::string expected;
+  for (std::string_view n : kLightSamplerNames)
+    expected += (expected.empty() ? "" : ", ") + std::string(n);
+  throw std::invalid_argument("unknown light sampler '" + name + "' (expected " + expected + ")");
 }
 
 } // namespace canopy

@@ -5,6 +5,7 @@
 //   "tree-split"  adaptive splitting (Alg. 3) with threshold and cut cap, then one light per
 //                 cluster of the cut
 //   "exhaustive"  every light with probability 1 (the reference)
+//   "bsdf"        no light (BSDF sampling only): sample() picks nothing, pmf() is 0
 // For every sampler, sum over the picks of f(pick.light) / pick.prob is an unbiased estimator of
 // sum over lights of f(light), for any f that is 0 where the sampler's importance is 0 (lights
 // behind the shading point's horizon or outside their emission cone: zero contribution).
@@ -13,6 +14,7 @@
 #include "light_tree/pmf.h"      // cl/
 #include "light_tree/split.h"    // cl/
 #include "light_tree/traverse.h" // cl/
+#include "lighttree/light_sampler_names.h"
 #include "lighttree/light_tree.h"
 
 #include <cstdint>
@@ -100,7 +102,7 @@ void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float thre
 std::unique_ptr<LightSampler> make_light_sampler(const std::string& name,
                                                  const std::vector<Light>& lights,
                                                  const LightSamplerOptions& opt = {});
-// "uniform", "power", "tree", "tree-split", "exhaustive".
+// kLightSamplerNames (lighttree/light_sampler_names.h), in SAMPLER_* order.
 const std::vector<std::string>& light_sampler_names();
 
 } // namespace canopy

@@ -3,23 +3,22 @@
 #include "types.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 namespace canopy {
 
-namespace {
-const char* kSamplerNames[] = {"uniform", "power", "tree", "tree-split", "exhaustive"};
-}
-
 int light_sampler_from_name(const std::string& name) {
-  for (int k = 0; k < 5; ++k)
-    if (name == kSamplerNames[k]) return k;
-  throw SceneError(fmt::format("light sampler '{}': unknown (uniform, power, tree, tree-split, "
-                               "exhaustive)",
-                               name));
+  int kind = light_sampler_kind(name);
+  if (kind < 0)
+    throw SceneError(
+        fmt::format("light sampler '{}': unknown ({})", name, fmt::join(kLightSamplerNames, ", ")));
+  return kind;
 }
 
 const char* light_sampler_name(int kind) {
-  return kind >= 0 && kind < 5 ? kSamplerNames[kind] : "?";
+  // The names are string literals: data() is NUL-terminated.
+  return kind >= 0 && size_t(kind) < kLightSamplerNames.size() ? kLightSamplerNames[kind].data()
+                                                               : "?";
 }
 
 KernelFeatures KernelFeatures::all(int light_sampler) {

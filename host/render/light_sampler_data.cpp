@@ -21,7 +21,7 @@ LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const
   } else if (d.kind == SAMPLER_TREE_SPLIT) {
     d.max_cut = uint32_t(std::clamp(max_cut, 1, int(std::max<uint32_t>(1, n))));
   }
-  if (d.kind >= SAMPLER_TREE) {
+  if (d.kind == SAMPLER_TREE || d.kind == SAMPLER_TREE_SPLIT || d.kind == SAMPLER_EXHAUSTIVE) {
     auto t0 = std::chrono::steady_clock::now();
     d.tree = build_light_tree(lights);
     d.tree.set_orientation_term(orientation_term);

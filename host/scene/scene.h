@@ -3,8 +3,9 @@
 // docs/scene-format.md.
 #pragma once
 
-#include "light_tree/split.h" // cl/: LT_DEFAULT_SPLIT_THRESHOLD
-#include "types.h"            // cl/types.h: Light, Material (device layouts)
+#include "light_tree/split.h"              // cl/: LT_DEFAULT_SPLIT_THRESHOLD
+#include "lighttree/light_sampler_names.h" // kLightSamplerNames
+#include "types.h"                         // cl/types.h: Light, Material (device layouts)
 
 #include <array>
 #include <cstdint>
@@ -33,9 +34,6 @@ inline constexpr int kMaxFilmSide = 16384;
 inline constexpr int kDefaultMaxCut = 64;
 inline constexpr int kMaxMaxCut = 1 << 16;
 inline constexpr int kMaxDepth = 1024; // path vertices after the camera hit
-// The light samplers, as the scene format, `canopy render` and `canopy converge` name them.
-inline constexpr std::array<std::string_view, 5> kLightSamplerNames = {"uniform", "power", "tree",
-                                                                       "tree-split", "exhaustive"};
 
 // `s` made safe to echo inside a one-line message: control characters (including NUL and C1
 // controls), invalid UTF-8 and the Unicode line/paragraph separators become \n, \t, \xHH or
