@@ -64,6 +64,41 @@ TEST_P(RenderFeatures, MinimalFeatureSetRendersTheSameImageAsEveryFeature) {
   EXPECT_NE(all_opts.find("-DHAS_LIGHT_DISK=1 -DHAS_PRIM_SPHERE=1 -DHAS_PRIM_DISK=1"),
             std::string::npos)
       << all_opts;
+  // a diffuse-only scene compiles no GGX or Fresnel code (cl/bsdf/bsdf.h)
+  EXPECT_NE(minimal_opts.find("-DHAS_MATERIAL_CONDUCTOR=0 -DHAS_MATERIAL_PLASTIC=0"),
+            std::string::npos)
+      << minimal_opts;
+  EXPECT_NE(all_opts.find("-DHAS_MATERIAL_CONDUCTOR=1 -DHAS_MATERIAL_PLASTIC=1"), std::string::npos)
+      << all_opts;
+  expect_identical(minimal, all);
+}
+
+TEST_P(RenderFeatures, SceneWithGlossyMaterialsRendersTheSameImageWithEveryFeature) {
+  // The default scene with its materials made conductors (rough and a perfect mirror) and
+  // plastics: the minimal build has the glossy code but no sphere, point or disk code.
+  Scene scene = small_default_scene();
+  ASSERT_GE(scene.materials.size(), 3u);
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    Material& m = scene.materials[i].gpu;
+    if (i % 3 == 0) {
+      m.type = MATERIAL_PLASTIC;
+      m.specular = make_float4(1, 1, 1, 0);
+      m.alpha = 0.04f;
+      m.ior = 1.5f;
+    } else {
+      m.type = MATERIAL_CONDUCTOR;
+      m.specular = make_float4(0.2f, 0.9f, 1.1f, 0); // eta
+      m.k = make_float4(3.9f, 2.5f, 2.4f, 0);
+      m.alpha = i % 3 == 1 ? 0.09f : 0.0f;
+    }
+  }
+  std::string minimal_opts;
+  Film minimal = render(scene, GetParam(), false, 1 << 18, &minimal_opts);
+  Film all = render(scene, GetParam(), true, 1 << 18);
+  EXPECT_NE(minimal_opts.find("-DHAS_MATERIAL_CONDUCTOR=1 -DHAS_MATERIAL_PLASTIC=1"),
+            std::string::npos)
+      << minimal_opts;
+  EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_DISK=0"), std::string::npos) << minimal_opts;
   expect_identical(minimal, all);
 }
 

@@ -70,3 +70,35 @@ TEST(SceneFiles, DocumentationExampleLoads) {
   EXPECT_EQ(s.lights.size(), 2u + 5u + 400u + 5000u + 300u + 1000u);
   EXPECT_EQ(s.film.width, 800);
 }
+
+// The glossy scenes of issue 11 (after Liu et al. 2019, Figs. 14 and 1).
+TEST(SceneFiles, GlossyCornellLoads) {
+  Scene s = load_scene(std::filesystem::path(CANOPY_SCENES_DIR) / "glossy-cornell.json");
+  EXPECT_EQ(s.lights.size(), 10000u);
+  for (const Light& l : s.lights)
+    EXPECT_EQ(l.type, LIGHT_SPHERE);
+  int plastic = 0;
+  for (const MaterialDesc& m : s.materials)
+    plastic += m.gpu.type == MATERIAL_PLASTIC;
+  EXPECT_EQ(plastic, 3);
+  EXPECT_FALSE(s.shading_normals.empty()); // the spheres are smooth-shaded meshes
+}
+
+TEST(SceneFiles, ShowroomLoads) {
+  Scene s = load_scene(std::filesystem::path(CANOPY_SCENES_DIR) / "showroom.json");
+  size_t disks = 0, quads = 0;
+  for (const Light& l : s.lights) {
+    disks += l.type == LIGHT_DISK;
+    quads += l.type == LIGHT_QUAD;
+  }
+  EXPECT_EQ(disks, 3744u);
+  EXPECT_EQ(quads, 1u);
+  int conductor = 0, plastic = 0;
+  for (const MaterialDesc& m : s.materials) {
+    conductor += m.gpu.type == MATERIAL_CONDUCTOR;
+    plastic += m.gpu.type == MATERIAL_PLASTIC;
+  }
+  EXPECT_GE(conductor, 1);
+  EXPECT_GE(plastic, 1);
+  EXPECT_FALSE(s.shading_normals.empty());
+}
