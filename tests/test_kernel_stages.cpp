@@ -202,10 +202,10 @@ void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& w
     expect_close(dev.shade_N[p].x, ref.shade_N[p].x, at + " N");
     EXPECT_EQ(float_as_uint_(dev.shade_N[p].w), float_as_uint_(ref.shade_N[p].w)) << at << " seed";
     expect_close4(dev.shade_f[p], ref.shade_f[p], at + " shade_f");
-    expect_close(dev.shade_wo[p].x, ref.shade_wo[p].x, at + " wo");
-    EXPECT_EQ(float_as_uint_(dev.shade_wo[p].w), float_as_uint_(ref.shade_wo[p].w))
+    expect_close4(dev.shade_wo[p], ref.shade_wo[p], at + " shade_wo");
+    expect_close(dev.shade_Ns[p].x, ref.shade_Ns[p].x, at + " Ns");
+    EXPECT_EQ(float_as_uint_(dev.shade_Ns[p].w), float_as_uint_(ref.shade_Ns[p].w))
         << at << " material";
-    expect_close4(dev.shade_Ns[p], ref.shade_Ns[p], at + " shade_Ns");
     if (::testing::Test::HasFailure()) return; // one path's report is enough
   }
 }

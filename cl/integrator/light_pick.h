@@ -21,22 +21,33 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   float3 P = xyz_of(pb->shade_P[path]);
   float3 N = xyz_of(pb->shade_N[path]);
   float4 f = pb->shade_f[path];
-  float4 wo_m = pb->shade_wo[path];
   float u1 = lt_rng_next(rng);
   float u2 = lt_rng_next(rng);
   LightSample s = sample_light(&ls->lights[light], P, u1, u2);
   // Light arriving from below the geometric surface would leak through it (shading normals).
   if (!(s.pdf > 0.0f) || !(dot(N, s.wi) > 0.0f) || !(max3(s.Li) > 0.0f) || !(pmf > 0.0f)) return 0;
-  Material m = sc->materials[(int)float_as_uint_(wo_m.w)];
-  Frame fr = frame_from(xyz_of(pb->shade_Ns[path]));
-  float3 wo = frame_to_local(&fr, xyz_of(wo_m));
-  float3 wi = frame_to_local(&fr, s.wi);
-  if (!(wi.z > 0.0f)) return 0;
-  float3 bsdf = bsdf_eval(&m, wo, wi);
+  float4 ns_m = pb->shade_Ns[path];
+  Material m = sc->materials[(int)float_as_uint_(ns_m.w)];
+  float3 Ns = xyz_of(ns_m);
+  float cos_s = dot(Ns, s.wi); // = the local frame's wi.z
+  if (!(cos_s > 0.0f)) return 0;
+  float3 bsdf;
+  float bsdf_p;
+  if (!HAS_MICROFACET || m.type == MATERIAL_DIFFUSE) {
+    // Lambertian needs no frame (the common case, and the only one of a diffuse-only kernel).
+    bsdf = diffuse_eval(&m, make_float3(0.0f, 0.0f, 1.0f), make_float3(0.0f, 0.0f, cos_s));
+    bsdf_p = diffuse_pdf(make_float3(0.0f, 0.0f, 1.0f), make_float3(0.0f, 0.0f, cos_s));
+  } else {
+    Frame fr = frame_from(Ns);
+    float3 wo = frame_to_local(&fr, xyz_of(pb->shade_wo[path]));
+    float3 wi = frame_to_local(&fr, s.wi);
+    bsdf = bsdf_eval(&m, wo, wi);
+    bsdf_p = bsdf_pdf(&m, wo, wi);
+  }
   // MIS against BSDF sampling when the path continues with it (never for delta lights).
   float w = 1.0f;
-  if (!s.is_delta && f.w > 0.0f) w = power_heuristic(pmf * s.pdf, bsdf_pdf(&m, wo, wi));
-  float3 c = xyz_of(f) * bsdf * s.Li * (wi.z * w / (s.pdf * pmf));
+  if (!s.is_delta && f.w > 0.0f) w = power_heuristic(pmf * s.pdf, bsdf_p);
+  float3 c = xyz_of(f) * bsdf * s.Li * (cos_s * w / (s.pdf * pmf));
   // A non-finite contribution is kept, not dropped: it reaches the path's radiance, where
   // accumulate counts the sample as non-finite (reported by --stats) and records it as zero.
   if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) return 0;

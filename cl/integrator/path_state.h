@@ -26,9 +26,9 @@
   /* xyz: path throughput beta at the shading point, w: 1 if light samples are MIS-weighted */     \
   /* against BSDF sampling (the path continues with a BSDF sample and MIS is on), else 0 */        \
   X(float4, shade_f)                                                                               \
-  /* xyz: unit direction towards the viewer, w: material index (int bits) */                       \
+  /* xyz: unit direction towards the viewer (read for glossy materials only) */                    \
   X(float4, shade_wo)                                                                              \
-  /* xyz: shading normal (on wo's side; the geometric normal when flat) */                         \
+  /* xyz: shading normal (on wo's side; the geometric normal when flat), w: material (int bits) */ \
   X(float4, shade_Ns)
 
 // The scene's buffers, likewise: X(element type, name), read-only on the device.

@@ -46,7 +46,8 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   float3 wo = -d;
   // Materials reflect on the side the ray arrives from: the shading frame faces wo too, with the
   // interpolated vertex normal of a smooth triangle where it is usable for wo (cl/shading.h).
-  float3 Ns = shading_normal_fix(N, wo, primitive_shading_normal(prim, sc->shading_normals, h.u, h.v, N));
+  float3 Ns =
+      shading_normal_fix(N, wo, primitive_shading_normal(prim, sc->shading_normals, h.u, h.v, N));
   // Every ray that leaves this point (the bounce and the shadow rays of light_pick) leaves on N's
   // side, so one origin serves them all: the hit point moved off the surface by its own error
   // bound (cl/shading.h). It is also the shading point recorded for light picking and MIS.
@@ -76,8 +77,8 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   out.y = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && bsdf_has_smooth_lobe(&m) && !black;
   pb->shade_N[path] = f4_from3(N, uint_as_float_(light_seed));
   pb->shade_f[path] = f4_from3(beta, continues && CANOPY_MIS ? 1.0f : 0.0f);
-  pb->shade_wo[path] = f4_from3(wo, uint_as_float_((uint)prim->material));
-  pb->shade_Ns[path] = f4_from3(Ns, 0.0f);
+  pb->shade_wo[path] = f4_from3(wo, 0.0f);
+  pb->shade_Ns[path] = f4_from3(Ns, uint_as_float_((uint)prim->material));
   pb->shade_P[path] = f4_from3(P, 0.0f);
   if (!continues) return out;
 
