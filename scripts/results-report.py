@@ -117,8 +117,9 @@ class Scene:
         self.t_eq = min(c[-1][0] for c in self.curves.values() if c)
         self.eq = {l: rmse_at(c, self.t_eq) for l, c in self.curves.items()}
         # Equal shadow rays (the paper's Fig. 12-13 axis).
+        # (A sampler without light samples, "bsdf", traces no shadow rays: it has no such curve.)
         self.ray_curves = {l: sorted((p[2], p[1], p[0], p[3]) for p in c)
-                           for l, c in self.curves.items()}
+                           for l, c in self.curves.items() if c and c[-1][2] > 0}
         self.r_eq = min(c[-1][0] for c in self.ray_curves.values() if c)
         self.eq_rays = {l: rmse_at(c, self.r_eq) for l, c in self.ray_curves.items()}
         self.rel_curves = {l: curve(self.median, l, "relmse") for l in self.labels}
@@ -209,7 +210,7 @@ def scene_section(s, clamp, seeds, docs, glossy=False):
     out.append("")
     out.append(f"At equal shadow rays ({s.r_eq:.3g} per image, the most every curve reaches): " +
                ", ".join(f"{l} {fmt_e(s.eq_rays[l][0])}{'*' if s.eq_rays[l][1] else ''}"
-                         for l in s.labels) + ".\n")
+                         for l in s.labels if l in s.eq_rays) + ".\n")
     out.append(f"![{s.name}: RMSE against time](results/{s.name}-time.png)\n")
     out.append(f"![{s.name}: RMSE against shadow rays](results/{s.name}-rays.png)\n")
     hm = os.path.join(docs, f"{s.name}-heatmap.png")

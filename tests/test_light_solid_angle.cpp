@@ -5,6 +5,8 @@
 // (chi-square against the exact solid angle of each bin).
 #include "light_sample.h"
 
+#include "support/double3.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -14,32 +16,6 @@
 #include <vector>
 
 namespace {
-
-// ---------------------------------------------------------------- double-precision geometry
-struct D3 {
-  double x, y, z;
-};
-D3 d3(float3 v) {
-  return {double(v.x), double(v.y), double(v.z)};
-}
-D3 operator+(D3 a, D3 b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-D3 operator-(D3 a, D3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-D3 operator*(D3 a, double s) {
-  return {a.x * s, a.y * s, a.z * s};
-}
-double ddot(D3 a, D3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-D3 dcross(D3 a, D3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-double dlen(D3 a) {
-  return std::sqrt(ddot(a, a));
-}
 
 // Solid angle of triangle (a, b, c) seen from the origin (Van Oosterom & Strackee), in double.
 double tri_omega(D3 a, D3 b, D3 c) {

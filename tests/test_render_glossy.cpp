@@ -11,6 +11,8 @@
 #include "render/renderer.h"
 #include "scene/scene.h"
 
+#include "support/double3.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,28 +22,6 @@
 using namespace canopy;
 
 namespace {
-
-struct V3 {
-  double x, y, z;
-};
-V3 operator+(V3 a, V3 b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-V3 operator-(V3 a, V3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-V3 operator*(V3 a, double s) {
-  return {a.x * s, a.y * s, a.z * s};
-}
-double dotv(V3 a, V3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-V3 unit(V3 a) {
-  return a * (1.0 / std::sqrt(dotv(a, a)));
-}
-V3 v3(float3 a) {
-  return {a.x, a.y, a.z};
-}
 
 // Unpolarised Fresnel reflectance for light arriving from air onto a medium of complex index
 // eta (conductor: n + ik; dielectric: real), from the amplitude coefficients.
@@ -55,23 +35,23 @@ double fresnel(double cos_i, std::complex<double> eta) {
 
 // GGX D and the height-correlated Smith G2 (alpha = roughness^2), in the frame with the plane's
 // normal +z.
-double ggx_d(V3 h, double a) {
+double ggx_d(D3 h, double a) {
   double c2 = h.z * h.z, t = c2 * (a * a - 1.0) + 1.0;
   return a * a / (M_PI * t * t);
 }
-double smith_lambda(V3 w, double a) {
+double smith_lambda(D3 w, double a) {
   double c2 = w.z * w.z, tan2 = std::max(0.0, 1.0 - c2) / c2;
   return 0.5 * (std::sqrt(1.0 + a * a * tan2) - 1.0);
 }
 
 // f(wo, wi) per channel for a Material record (plane normal +z, both directions above it).
-V3 brdf(const Material& m, V3 wo, V3 wi) {
+D3 brdf(const Material& m, D3 wo, D3 wi) {
   if (wo.z <= 0 || wi.z <= 0) return {0, 0, 0};
-  V3 h = unit(wo + wi);
+  D3 h = dunit(wo + wi);
   double a = m.alpha;
   double spec =
       ggx_d(h, a) / (1.0 + smith_lambda(wo, a) + smith_lambda(wi, a)) / (4.0 * wo.z * wi.z);
-  double c = dotv(wo, h);
+  double c = ddot(wo, h);
   if (m.type == MATERIAL_CONDUCTOR) {
     return {spec * fresnel(c, {m.specular.x, m.k.x}), spec * fresnel(c, {m.specular.y, m.k.y}),
             spec * fresnel(c, {m.specular.z, m.k.z})};
@@ -115,16 +95,16 @@ Scene make_scene(const std::string& lights_json, const Material& m) {
   return s;
 }
 
-using Radiance = std::function<V3(V3 x, V3 wo)>;
+using Radiance = std::function<D3(D3 x, D3 wo)>;
 
 // The pixel's box-filtered radiance by an n x n midpoint rule over its footprint.
-V3 pixel_reference(const CameraParams& cam, int px, int py, int n, const Radiance& L) {
-  V3 acc{0, 0, 0};
-  V3 o = v3(xyz_of(cam.origin));
+D3 pixel_reference(const CameraParams& cam, int px, int py, int n, const Radiance& L) {
+  D3 acc{0, 0, 0};
+  D3 o = d3(xyz_of(cam.origin));
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) {
       double x = px + (a + 0.5) / n, y = py + (b + 0.5) / n;
-      V3 d = unit(v3(xyz_of(cam.lower_left)) + v3(xyz_of(cam.du)) * x + v3(xyz_of(cam.dv)) * y);
+      D3 d = dunit(d3(xyz_of(cam.lower_left)) + d3(xyz_of(cam.du)) * x + d3(xyz_of(cam.dv)) * y);
       double t = -o.z / d.z;
       acc = acc + L(o + d * t, d * -1.0);
     }
@@ -149,8 +129,8 @@ double check_render(Scene& scene, const RendererOptions& opt, int spp, const Rad
   for (int y = 0; y < film.height; ++y)
     for (int x = 0; x < film.width; ++x) {
       size_t p = size_t(y) * size_t(film.width) + size_t(x);
-      V3 r = pixel_reference(cam, x, y, n_fine, fine);
-      V3 rc = pixel_reference(cam, x, y, n_coarse, coarse);
+      D3 r = pixel_reference(cam, x, y, n_fine, fine);
+      D3 rc = pixel_reference(cam, x, y, n_coarse, coarse);
       double n = film.sum[p].w;
       const double* sum = &film.sum[p].x;
       const double* sq = &film.sumsq[p].x;
@@ -182,7 +162,7 @@ double check_render(Scene& scene, const RendererOptions& opt, int spp, const Rad
 }
 
 struct PointLightDesc {
-  V3 p, I;
+  D3 p, I;
 };
 const std::vector<PointLightDesc> kPoints = {
     {{0.5, 0.5, 1.0}, {2.0, 1.0, 0.5}},
@@ -212,15 +192,15 @@ TEST_P(GlossyPointLights, PixelMeansMatchTheExactRadiance) {
   const auto& [sampler, material, roughness] = GetParam();
   Material m = material == "conductor" ? conductor(roughness) : plastic(roughness);
   Scene scene = make_scene(points_json(), m);
-  Radiance L = [&](V3 x, V3 wo) {
-    V3 sum{0, 0, 0};
+  Radiance L = [&](D3 x, D3 wo) {
+    D3 sum{0, 0, 0};
     for (const auto& l : kPoints) {
-      V3 to = l.p - x;
-      double d2 = dotv(to, to);
-      V3 wi = to * (1.0 / std::sqrt(d2));
-      V3 f = brdf(m, wo, wi);
+      D3 to = l.p - x;
+      double d2 = ddot(to, to);
+      D3 wi = to * (1.0 / std::sqrt(d2));
+      D3 f = brdf(m, wo, wi);
       double g = std::max(0.0, wi.z) / d2;
-      sum = sum + V3{f.x * l.I.x * g, f.y * l.I.y * g, f.z * l.I.z * g};
+      sum = sum + D3{f.x * l.I.x * g, f.y * l.I.y * g, f.z * l.I.z * g};
     }
     return sum;
   };
@@ -255,30 +235,30 @@ class GlossyQuadLight : public ::testing::TestWithParam<std::tuple<std::string, 
 TEST_P(GlossyQuadLight, PixelMeansMatchQuadratureOverTheLight) {
   const auto& [material, roughness, mis] = GetParam();
   Material m = material == "conductor" ? conductor(roughness) : plastic(roughness);
-  const V3 corner{-0.5, 2.8, 1.6}, e1{1.0, 0.0, 0.0}, e2{0.0, -0.4, 0.4};
-  const V3 Le{3.0, 2.0, 1.0};
+  const D3 corner{-0.5, 2.8, 1.6}, e1{1.0, 0.0, 0.0}, e2{0.0, -0.4, 0.4};
+  const D3 Le{3.0, 2.0, 1.0};
   Scene scene = make_scene(R"([{"type": "quad", "corner": [-0.5, 2.8, 1.6], "edge1": [1, 0, 0],
                                 "edge2": [0, -0.4, 0.4], "radiance": [3, 2, 1]}])",
                            m);
   ASSERT_EQ(scene.lights.size(), 1u);
   // Emitting side: the light's normal must face the plane (it points down and towards -y).
-  V3 ln = v3(xyz_of(scene.lights[0].n));
+  D3 ln = d3(xyz_of(scene.lights[0].n));
   ASSERT_LT(ln.z, 0.0);
-  double area = std::sqrt(dotv(e1, e1) * dotv(e2, e2) - dotv(e1, e2) * dotv(e1, e2));
+  double area = std::sqrt(ddot(e1, e1) * ddot(e2, e2) - ddot(e1, e2) * ddot(e1, e2));
   auto quadrature = [&](int k) {
-    return [&, k](V3 x, V3 wo) {
-      V3 sum{0, 0, 0};
+    return [&, k](D3 x, D3 wo) {
+      D3 sum{0, 0, 0};
       for (int i = 0; i < k; ++i)
         for (int j = 0; j < k; ++j) {
-          V3 y = corner + e1 * ((i + 0.5) / k) + e2 * ((j + 0.5) / k);
-          V3 to = y - x;
-          double d2 = dotv(to, to);
-          V3 wi = to * (1.0 / std::sqrt(d2));
-          double cos_l = -dotv(ln, wi);
+          D3 y = corner + e1 * ((i + 0.5) / k) + e2 * ((j + 0.5) / k);
+          D3 to = y - x;
+          double d2 = ddot(to, to);
+          D3 wi = to * (1.0 / std::sqrt(d2));
+          double cos_l = -ddot(ln, wi);
           if (cos_l <= 0 || wi.z <= 0) continue;
-          V3 f = brdf(m, wo, wi);
+          D3 f = brdf(m, wo, wi);
           double g = wi.z * cos_l / d2;
-          sum = sum + V3{f.x * Le.x * g, f.y * Le.y * g, f.z * Le.z * g};
+          sum = sum + D3{f.x * Le.x * g, f.y * Le.y * g, f.z * Le.z * g};
         }
       return sum * (area / (k * k));
     };
