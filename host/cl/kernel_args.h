@@ -30,7 +30,7 @@ class ArgValue {
 public:
   ArgValue() = default;
   ArgValue(const cl::Buffer& b) : buffer_(b) {
-    if (b() != nullptr) type_ = kBuffer, size_ = sizeof(cl_mem);
+    if (b() != nullptr) type_ = kBuffer, size_ = sizeof(cl_mem), is_buffer_ = true;
   }
   ArgValue(cl_int v) { store("int", v); }
   ArgValue(cl_uint v) { store("uint", v); }
@@ -40,7 +40,9 @@ public:
   ArgValue(const int2& v) { store("int2", v); }
 
   bool empty() const { return type_ == nullptr; }
-  bool is_buffer() const { return type_ == kBuffer; }
+  // A flag, not type_ == kBuffer: the literal's address can differ between translation units
+  // (AddressSanitizer gives each its own copy), which made buffers look like scalars.
+  bool is_buffer() const { return is_buffer_; }
   // "buffer", an OpenCL C scalar type name ("int", "float4", ...), or "no value".
   const char* type() const { return type_ ? type_ : "no value"; }
   // The buffer (a null buffer if this is not one).
@@ -61,6 +63,7 @@ private:
 
   const char* type_ = nullptr;
   size_t size_ = 0;
+  bool is_buffer_ = false;
   alignas(16) unsigned char bytes_[16] = {};
   cl::Buffer buffer_;
 };
