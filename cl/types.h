@@ -110,6 +110,20 @@ typedef struct ShadowItem {
   float4 contribution; // rgb
 } ShadowItem;
 
+// One BRDF-aware sample of a glossy point (Liu et al. 2019, §4.2, §5), a work item of the BRDF
+// rounds (cl/integrator/brdf_mis.h): a BRDF-oriented light sample (a shadow ray whose
+// contribution is final unless occluded) or a BSDF sample (a probe ray whose contribution is known
+// once its closest hit is: the emitter it finds, if any).
+#define BRDF_ITEM_LIGHT 0
+#define BRDF_ITEM_BSDF 1
+typedef struct BrdfItem {
+  float4 origin; // xyz origin, w: tmax (a BSDF probe: 0 = absorbed, nothing to trace)
+  float4 dir;    // xyz unit direction, w: path id (as int bits)
+  float4 value;  // light: rgb contribution; BSDF: beta f cos / N, to be weighted at the hit
+  float4 extra;  // x: BSDF pdf, y: probability of choosing BRDF-oriented light sampling,
+                 // z: BRDF_ITEM_*, w: 1 if the probe found an emitter (after brdf_trace)
+} BrdfItem;
+
 // A cluster of lights waiting in the split queue (Conty Estevez & Kulla 2018, Alg. 3 unrolled into
 // passes): `code` is a light-tree node or leaf (cl/light_tree/layout.h), `sphere` and `cv2` its
 // bounding sphere and energy CV^2 (the split measure's inputs), `budget` the cut size it may still
@@ -129,5 +143,9 @@ typedef struct SplitItem {
 #define SAMPLER_TREE_SPLIT 3
 #define SAMPLER_EXHAUSTIVE 4
 #define SAMPLER_BSDF 5 // no light sampling: emission is found by BSDF-sampled rays alone
+// Liu, Xu & Yan 2019 at glossy points (tree-split elsewhere): BRDF-oriented light sampling, tree
+// light sampling with splitting and BSDF sampling, MIS-combined with adaptive sample allocation.
+#define SAMPLER_BRDF_MIS 6
+#define SAMPLER_BRDF_ORIENTED 7 // BRDF-oriented light sampling alone at glossy points (ablation)
 
 #endif // CANOPY_CL_TYPES_H

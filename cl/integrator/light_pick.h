@@ -7,9 +7,8 @@
 #ifndef CANOPY_INTEGRATOR_LIGHT_PICK_H
 #define CANOPY_INTEGRATOR_LIGHT_PICK_H
 
-#include "../bsdf/bsdf.h"
-#include "../light_sample.h"
-#include "../shading.h"
+#include "brdf_mis.h"
+#include "light_point.h"
 #include "light_sampler.h"
 #include "path_state.h"
 
@@ -18,49 +17,29 @@
 INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers* sc,
                                   const PathBuffers* pb, int path, int light, float pmf, LtRng* rng,
                                   GLOBAL ShadowItem* out) {
-  float3 P = xyz_of(pb->shade_P[path]);
-  float3 N = xyz_of(pb->shade_N[path]);
-  float4 f = pb->shade_f[path];
   float u1 = lt_rng_next(rng);
   float u2 = lt_rng_next(rng);
-  LightSample s = sample_light(&ls->lights[light], P, u1, u2);
-  // Light arriving from below the geometric surface would leak through it (shading normals).
-  if (!(s.pdf > 0.0f) || !(dot(N, s.wi) > 0.0f) || !(max3(s.Li) > 0.0f) || !(pmf > 0.0f)) return 0;
-  float4 ns_m = pb->shade_Ns[path];
-  Material m = sc->materials[(int)float_as_uint_(ns_m.w)];
-  float3 Ns = xyz_of(ns_m);
-  float cos_s = dot(Ns, s.wi); // = the local frame's wi.z
-  if (!(cos_s > 0.0f)) return 0;
-  float3 bsdf;
-  float bsdf_p;
-  if (!HAS_MICROFACET || m.type == MATERIAL_DIFFUSE) {
-    // Lambertian needs no frame (the common case, and the only one of a diffuse-only kernel).
-    bsdf = diffuse_eval(&m, make_float3(0.0f, 0.0f, 1.0f), make_float3(0.0f, 0.0f, cos_s));
-    bsdf_p = diffuse_pdf(make_float3(0.0f, 0.0f, 1.0f), make_float3(0.0f, 0.0f, cos_s));
-  } else {
-    Frame fr = frame_from(Ns);
-    float3 wo = frame_to_local(&fr, xyz_of(pb->shade_wo[path]));
-    float3 wi = frame_to_local(&fr, s.wi);
-    bsdf = bsdf_eval(&m, wo, wi);
-    bsdf_p = bsdf_pdf(&m, wo, wi);
-  }
-  // MIS against BSDF sampling when the path continues with it (never for delta lights).
+  LightPoint lp;
+  if (!(pmf > 0.0f) || !light_point_sample(ls, sc, pb, path, light, u1, u2, &lp)) return 0;
+  float f_w = pb->shade_f[path].w;
   float w = 1.0f;
-  if (!s.is_delta && f.w > 0.0f) w = power_heuristic(pmf * s.pdf, bsdf_p);
-  float3 c = xyz_of(f) * bsdf * s.Li * (cos_s * w / (s.pdf * pmf));
+  float p_L = pmf * lp.s.pdf;
+  if (HAS_MICROFACET && light_sampler_brdf(ls) && f_w == BRDF_POINT_FLAG) {
+    // A glossy point: against its N BRDF-aware samples (brdf_mis.h).
+    BrdfPoint bp = brdf_point(ls, sc, pb, path);
+    w = brdf_weight_tree(ls, p_L, brdf_light_pmf(ls, &bp, light) * lp.s.pdf, lp.bsdf_pdf,
+                         bp.state.y);
+  } else if (f_w > 0.0f) {
+    // MIS against BSDF sampling when the path continues with it (bsdf_pdf 0: delta lights).
+    w = power_heuristic(p_L, lp.bsdf_pdf);
+  }
+  float3 c = xyz_of(pb->shade_f[path]) * lp.f_cos * lp.s.Li * (w / p_L);
   // A non-finite contribution is kept, not dropped: it reaches the path's radiance, where
   // accumulate counts the sample as non-finite (reported by --stats) and records it as zero.
   if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) return 0;
-  // P is already off the surface (shade_surface). The ray ends short of the light point by the
-  // float error of that point's own coordinates and of the distance, not by a scene-wide margin;
-  // an area light's point is already off the light's surface (sample_light).
-  float3 to = s.x - P;
-  float dist = length(to);
-  if (!(dist > 0.0f)) return 0;
-  float tmax = dist - fp_gamma(6) * (max_abs3(s.x) + dist);
   ShadowItem item;
-  item.origin = f4_from3(P, fmax(tmax, 0.0f));
-  item.dir = f4_from3(to / dist, uint_as_float_((uint)path));
+  item.origin = lp.origin;
+  item.dir = lp.dir;
   item.contribution = f4_from3(c, 0.0f);
   *out = item;
   return 1;

@@ -1,7 +1,8 @@
 // The light-selection techniques behind one interface, shared by the light_pick/shade_surface
 // kernels and the host reference: uniform, power (alias table), tree (Conty Estevez & Kulla 2018
-// Alg. 2), tree with adaptive splitting (Alg. 3), exhaustive (every light; the reference) and bsdf
-// (no light: BSDF sampling only, nothing to pick, pmf 0).
+// Alg. 2), tree with adaptive splitting (Alg. 3), exhaustive (every light; the reference), bsdf
+// (no light: BSDF sampling only, nothing to pick, pmf 0), and brdf-mis / brdf-oriented, which are
+// tree-split here and add BRDF-oriented sampling at glossy points (brdf_mis.h).
 #ifndef CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 #define CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 
@@ -19,6 +20,14 @@ typedef struct LightSamplerCtx {
   LtTree tree;     // tree, tree-split, exhaustive
   float threshold; // tree-split: split while the measure is below it (>= 1: always)
   uint max_cut;    // tree-split: cut size cap per shading point
+  // brdf-mis, brdf-oriented (cl/integrator/brdf_mis.h): LT_BRDF_MAX_CUT cut entries per path of
+  // the wave, the split threshold delta on S_C (Eq. 5), N_max (Eq. 9), lambda (Eq. 7), and
+  // adaptive allocation (0: one sample of each technique).
+  GLOBAL float2* brdf_cut;
+  float brdf_delta;
+  float brdf_lambda;
+  int brdf_nmax;
+  int brdf_adaptive;
 } LightSamplerCtx;
 
 // The split-queue root item of a shading point.
@@ -63,8 +72,13 @@ INLINE float light_sampler_pmf(const LightSamplerCtx* ls, float3 P, float3 N, in
   return lt_pmf_split(&ls->tree, P, N, light, ls->threshold, ls->max_cut);
 }
 
+// brdf-mis and brdf-oriented are tree-split at points without a glossy BRDF.
 INLINE int light_sampler_splits(const LightSamplerCtx* ls) {
-  return ls->kind == SAMPLER_TREE_SPLIT || ls->kind == SAMPLER_EXHAUSTIVE;
+  return ls->kind == SAMPLER_TREE_SPLIT || ls->kind == SAMPLER_EXHAUSTIVE ||
+         ls->kind == SAMPLER_BRDF_MIS || ls->kind == SAMPLER_BRDF_ORIENTED;
+}
+INLINE int light_sampler_brdf(const LightSamplerCtx* ls) {
+  return ls->kind == SAMPLER_BRDF_MIS || ls->kind == SAMPLER_BRDF_ORIENTED;
 }
 
 #endif // CANOPY_INTEGRATOR_LIGHT_SAMPLER_H

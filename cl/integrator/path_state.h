@@ -24,12 +24,16 @@
   /* xyz: geometric normal facing wo, w: light-pick seed (uint bits) */                           \
   X(float4, shade_N)                                                                               \
   /* xyz: path throughput beta at the shading point, w: 1 if light samples are MIS-weighted */     \
-  /* against BSDF sampling (the path continues with a BSDF sample and MIS is on), else 0 */        \
+  /* against BSDF sampling (the path continues with a BSDF sample and MIS is on), else 0; */       \
+  /* BRDF_POINT_FLAG (2): a glossy point of a BRDF sampler (brdf_mis.h) */                        \
   X(float4, shade_f)                                                                               \
   /* xyz: unit direction towards the viewer (read for glossy materials only) */                    \
   X(float4, shade_wo)                                                                              \
   /* xyz: shading normal (on wo's side; the geometric normal when flat), w: material (int bits) */ \
-  X(float4, shade_Ns)
+  X(float4, shade_Ns)                                                                              \
+  /* brdf-mis, brdf-oriented (brdf_mis.h): x: cut size, y: BRDF-aware samples N (-1: a glossy */   \
+  /* point whose cut is not built yet), z: samples drawn, w: n_hit | n_nohit << 16 (Alg. 1) */     \
+  X(int4, brdf_state)
 
 // The scene's buffers, likewise: X(element type, name), read-only on the device.
 #define SCENE_BUFFERS(X)                                                                           \

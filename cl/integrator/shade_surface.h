@@ -16,6 +16,7 @@
 #include "../light_sample.h"
 #include "../rng.h"
 #include "../shading.h"
+#include "brdf_mis.h"
 #include "light_sampler.h"
 #include "path_state.h"
 
@@ -25,6 +26,9 @@ INLINE float shade_emission_weight(const LightSamplerCtx* ls, const PathBuffers*
                                    int depth, int light, float3 P) {
   float4 prev_P = pb->shade_P[path];
   if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
+  // A glossy point of a BRDF sampler has its direct light complete without its bounce (brdf_mis.h)
+  if (HAS_MICROFACET && light_sampler_brdf(ls) && pb->shade_f[path].w == BRDF_POINT_FLAG)
+    return 0.0f;
   if (!CANOPY_MIS) return 0.0f; // light sampling alone accounts for it
   float3 prev_N = xyz_of(pb->shade_N[path]);
   float pmf = light_sampler_pmf(ls, xyz_of(prev_P), prev_N, light);
@@ -75,8 +79,17 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   // Light shapes are black diffuse: nothing to pick lights for.
   int black = m.type == MATERIAL_DIFFUSE && !(max3(xyz_of(m.albedo)) > 0.0f);
   out.y = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && bsdf_has_smooth_lobe(&m) && !black;
+  float mis_flag = continues && CANOPY_MIS ? 1.0f : 0.0f;
+  if (HAS_MICROFACET && light_sampler_brdf(ls)) {
+    // Glossy points get BRDF-oriented sampling (brdf_mis.h: -1 asks brdf_cut for the cut);
+    // brdf-oriented alone takes no tree light sample there.
+    int glossy = out.y && brdf_material_glossy(&m);
+    pb->brdf_state[path] = make_int4(0, glossy ? -1 : 0, 0, 0);
+    if (glossy) mis_flag = BRDF_POINT_FLAG;
+    if (glossy && ls->kind == SAMPLER_BRDF_ORIENTED) out.y = 0;
+  }
   pb->shade_N[path] = f4_from3(N, uint_as_float_(light_seed));
-  pb->shade_f[path] = f4_from3(beta, continues && CANOPY_MIS ? 1.0f : 0.0f);
+  pb->shade_f[path] = f4_from3(beta, mis_flag);
   pb->shade_wo[path] = f4_from3(wo, 0.0f);
   pb->shade_Ns[path] = f4_from3(Ns, uint_as_float_((uint)prim->material));
   pb->shade_P[path] = f4_from3(P, 0.0f);

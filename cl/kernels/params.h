@@ -14,6 +14,11 @@
 #ifndef CANOPY_LIGHT_SAMPLER
 #define CANOPY_LIGHT_SAMPLER SAMPLER_UNIFORM
 #endif
+// The kernels of BRDF-oriented sampling (brdf_mis.cl) exist only for a BRDF sampler on a scene
+// with a glossy material.
+#define HAS_BRDF_ORIENTED                                                                          \
+  (HAS_MICROFACET &&                                                                               \
+   (CANOPY_LIGHT_SAMPLER == SAMPLER_BRDF_MIS || CANOPY_LIGHT_SAMPLER == SAMPLER_BRDF_ORIENTED))
 
 // The path state and the scene, generated from PATH_STATE_BUFFERS and SCENE_BUFFERS.
 #define CANOPY_PATH_PARAM(T, name) __global T *name,
@@ -33,7 +38,8 @@
       __global const float *alias_prob, __global const int *alias_index,                           \
       __global const float4 *lt_nodes, __global const int4 *lt_children,                           \
       __global const int *lt_leaf_lights, __global const uint *lt_trails, float4 lt_root_sphere,   \
-      float4 lt_root_info, float split_threshold, uint max_cut,
+      float4 lt_root_info, float split_threshold, uint max_cut, __global float2 *brdf_cut,       \
+      float brdf_delta, float brdf_lambda, int brdf_nmax, int brdf_adaptive,
 
 #define LIGHT_SAMPLER_ASSEMBLE(ls)                                                                 \
   LightSamplerCtx ls;                                                                              \
@@ -51,7 +57,12 @@
   ls.tree.root_sphere = lt_root_sphere;                                                            \
   ls.tree.root_info = lt_root_info;                                                                \
   ls.threshold = split_threshold;                                                                  \
-  ls.max_cut = max_cut
+  ls.max_cut = max_cut;                                                                            \
+  ls.brdf_cut = brdf_cut;                                                                          \
+  ls.brdf_delta = brdf_delta;                                                                      \
+  ls.brdf_lambda = brdf_lambda;                                                                    \
+  ls.brdf_nmax = brdf_nmax;                                                                        \
+  ls.brdf_adaptive = brdf_adaptive
 
 // An exclusive scan's input (counts) and result (block_sums[i / block] + offsets[i]).
 #define SCAN_PARAMS                                                                                \

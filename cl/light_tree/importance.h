@@ -22,12 +22,80 @@ LT_HOT v4f lt_vcross_len(v4f ax, v4f ay, v4f az, v4f dx, v4f dy, v4f dz) {
 }
 
 // ---------------------------------------------------------------- cluster importance (Eq. 3)
+// The four lanes (clusters or emitters) a node or a leaf ranks, decoded from its records.
+typedef struct LtLanes {
+  v4f cx, cy, cz, r;  // bounding spheres
+  v4f ax, ay, az;     // cone axes (0 when every lane's cone is the full sphere)
+  v4f cos_o, cos_e;   // cone: normal bound theta_o, emission bound theta_e
+  v4f energy;         // 0: unused lane
+  v4f plane_h;        // half-space bound offset (LT_PLANE_NONE: none)
+} LtLanes;
+
+// The geometry of four clusters seen from P, shared by the importance of Conty Estevez & Kulla
+// (Eq. 3) and the BRDF-oriented one of Liu et al. (cl/light_tree/brdf_cut.h): the vector d from P
+// to each centre, d^2, 1/d, the half-angle theta_u of the cone from P around each bounding
+// sphere as (sin, cos) (theta_u = pi inside the sphere), and the orientation bound cos(theta') =
+// cos(max(theta - theta_o - theta_u, 0)), 0 when theta' >= theta_e. `front` is false for a lane
+// whose half-space bound puts P behind all its one-sided planar emitters.
+typedef struct LtView {
+  v4f dx, dy, dz, d2, inv_d, sin_u, cos_u, orient;
+  v4m inside, front;
+} LtView;
+
+// All angle differences use cos(a-b) = cos a cos b + sin a sin b (no acos).
+LT_HOT LtView lt_view_v(const LtLanes* l, float3 P) {
+  LtView v;
+  v4f zero = v4_splat(0.0f);
+  v4f one = v4_splat(1.0f);
+  v.dx = v4_sub(l->cx, v4_splat(P.x));
+  v.dy = v4_sub(l->cy, v4_splat(P.y));
+  v.dz = v4_sub(l->cz, v4_splat(P.z));
+  v.d2 = v4_add(v4_add(v4_mul(v.dx, v.dx), v4_mul(v.dy, v.dy)), v4_mul(v.dz, v.dz));
+  v4f r2 = v4_mul(l->r, l->r);
+  v.inside = v4_le(v.d2, r2);
+  // Every cosine and sine below is a dot or cross product scaled by 1/d, so the square roots run
+  // side by side instead of one after the other (the latency of this function bounds a descent).
+  v.inv_d = v4_div(one, v4_sqrt(v4_max(v.d2, v4_splat(1e-36f))));
+  // theta_u: half-angle of the cone from P around the bounding sphere
+  v4f sin_u = v4_min(v4_mul(l->r, v.inv_d), one);
+  v4f cos_u = v4_min(v4_mul(v4_sqrt(v4_max(v4_sub(v.d2, r2), zero)), v.inv_d), one);
+  v.sin_u = v4_sel(sin_u, zero, v.inside);
+  v.cos_u = v4_sel(cos_u, v4_splat(-1.0f), v.inside);
+  // Fast path: four full-sphere cones (theta_o = pi: points, spheres, two-sided emitters and
+  // their clusters, every lane under LT_TERMS_DISTANCE) bound every direction, theta' = 0 and
+  // cos(theta') = 1; for finite P the general code gives exactly the same (c1 = 1, s1 = 0, c2 = 1)
+  // at the cost of the axis (lt_decode_axes: not even decoded) and a third of this function.
+  // Full-sphere lanes never carry a half-space bound, so `front` is all true there.
+  v4m full = v4_le(l->cos_o, v4_splat(-1.0f));
+  v.front = full;
+  if (v4_all(full)) {
+    v.orient = v4_sel(zero, one, v4_gt(one, l->cos_e));
+    return v;
+  }
+  // theta: angle between the cone axis and the direction from the cluster towards P
+  v4f cos_t = v4_mul(
+      v4_sub(zero, v4_add(v4_add(v4_mul(l->ax, v.dx), v4_mul(l->ay, v.dy)), v4_mul(l->az, v.dz))),
+      v.inv_d);
+  // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
+  v.front = v4_gt(cos_t, v4_sub(zero, v4_add(v4_mul(l->plane_h, v.inv_d),
+                                              v4_splat(LT_PLANE_SLOPE))));
+  v4f sin_t = v4_min(v4_mul(lt_vcross_len(l->ax, l->ay, l->az, v.dx, v.dy, v.dz), v.inv_d), one);
+  v4f sin_o = v4_sqrt(v4_max(v4_sub(one, v4_mul(l->cos_o, l->cos_o)), zero));
+  // theta - theta_o, clamped at 0
+  v4m within_o = v4_ge(cos_t, l->cos_o);
+  v4f c1 = v4_sel(v4_add(v4_mul(cos_t, l->cos_o), v4_mul(sin_t, sin_o)), one, within_o);
+  v4f s1 = v4_sel(v4_sub(v4_mul(sin_t, l->cos_o), v4_mul(cos_t, sin_o)), zero, within_o);
+  // minus theta_u, clamped at 0
+  v4f c2 = v4_sel(v4_add(v4_mul(c1, v.cos_u), v4_mul(s1, v.sin_u)), one, v4_ge(c1, v.cos_u));
+  v.orient = v4_sel(zero, c2, v4_gt(c2, l->cos_e));
+  return v;
+}
+
 // Importance of four clusters for a shading point P with unit normal N (N = 0: no orientation,
 // e.g. a point in a medium or a two-sided/transmissive surface). Per lane:
-//   E * cos(theta') * max(cos(theta_i'), 0) / max(d^2, (r/2)^2), 0 when theta' >= theta_e,
-// theta' = max(theta - theta_o - theta_u, 0), theta_i' = max(theta_i - theta_u, 0), sin(theta_u) =
-// r/d and theta_u = pi inside the sphere. All angle differences use cos(a-b) = cos a cos b +
-// sin a sin b (no acos). Emitters below the horizon of N are culled (opaque surfaces).
+//   E * cos(theta') * max(cos(theta_i'), 0) / max(d^2, (r/2)^2)
+// (lt_view_v for theta'), theta_i' = max(theta_i - theta_u, 0). Emitters below the horizon of N
+// are culled (opaque surfaces).
 // Lanes are normalised by the largest energy and the smallest clamped d^2 among the lanes (only
 // ratios matter) and a lane that can contribute gets at least LT_IMPORTANCE_FLOOR: the result is
 // never 0 for a cluster that can contribute and never overflows. A lane whose half-space bound
@@ -35,69 +103,29 @@ LT_HOT v4f lt_vcross_len(v4f ax, v4f ay, v4f az, v4f dx, v4f dy, v4f dz) {
 // emitters is 0 whatever its sphere, P inside it included. If no lane can contribute and
 // `fallback` is set (stochastic descents), lanes with energy get E/d^2 (see below); only lanes
 // without energy are ever 0 then. Without `fallback` (splitting) such lanes stay 0.
-LT_HOT v4f lt_importance_v(v4f cx, v4f cy, v4f cz, v4f r, v4f ax, v4f ay, v4f az, v4f cos_o,
-                           v4f cos_e, v4f energy, v4f plane_h, float3 P, float3 N, int fallback) {
+LT_HOT v4f lt_importance_v(const LtLanes* l, float3 P, float3 N, int fallback) {
   v4f zero = v4_splat(0.0f);
   v4f one = v4_splat(1.0f);
-  v4f dx = v4_sub(cx, v4_splat(P.x));
-  v4f dy = v4_sub(cy, v4_splat(P.y));
-  v4f dz = v4_sub(cz, v4_splat(P.z));
-  v4f d2 = v4_add(v4_add(v4_mul(dx, dx), v4_mul(dy, dy)), v4_mul(dz, dz));
-  v4f r2 = v4_mul(r, r);
-  v4m inside = v4_le(d2, r2);
-  v4f d2c = v4_max(v4_max(d2, v4_mul(r2, v4_splat(0.25f))), v4_splat(1e-36f));
-  // Every cosine and sine below is a dot or cross product scaled by 1/d, so the square roots run
-  // side by side instead of one after the other (the latency of this function bounds a descent).
-  v4f inv_d = v4_div(one, v4_sqrt(v4_max(d2, v4_splat(1e-36f))));
-  // theta_u: half-angle of the cone from P around the bounding sphere
-  v4f sin_u = v4_min(v4_mul(r, inv_d), one);
-  v4f cos_u = v4_min(v4_mul(v4_sqrt(v4_max(v4_sub(d2, r2), zero)), inv_d), one);
-  sin_u = v4_sel(sin_u, zero, inside);
-  cos_u = v4_sel(cos_u, v4_splat(-1.0f), inside);
-  // Fast path: four full-sphere cones (theta_o = pi: points, spheres, two-sided emitters and
-  // their clusters, every lane under LT_TERMS_DISTANCE) bound every direction, theta' = 0 and
-  // cos(theta') = 1; for finite P the general code gives exactly the same (c1 = 1, s1 = 0, c2 = 1)
-  // at the cost of the axis (lt_decode_axes: not even decoded) and a third of this function.
-  // Full-sphere lanes never carry a half-space bound, so `front` is all true there.
-  v4f orient;
-  v4m full = v4_le(cos_o, v4_splat(-1.0f));
-  v4m front = full;
-  if (v4_all(full)) {
-    orient = v4_sel(zero, one, v4_gt(one, cos_e));
-  } else {
-    // theta: angle between the cone axis and the direction from the cluster towards P
-    v4f cos_t =
-        v4_mul(v4_sub(zero, v4_add(v4_add(v4_mul(ax, dx), v4_mul(ay, dy)), v4_mul(az, dz))), inv_d);
-    // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
-    front = v4_gt(cos_t, v4_sub(zero, v4_add(v4_mul(plane_h, inv_d), v4_splat(LT_PLANE_SLOPE))));
-    v4f sin_t = v4_min(v4_mul(lt_vcross_len(ax, ay, az, dx, dy, dz), inv_d), one);
-    v4f sin_o = v4_sqrt(v4_max(v4_sub(one, v4_mul(cos_o, cos_o)), zero));
-    // theta - theta_o, clamped at 0
-    v4m within_o = v4_ge(cos_t, cos_o);
-    v4f c1 = v4_sel(v4_add(v4_mul(cos_t, cos_o), v4_mul(sin_t, sin_o)), one, within_o);
-    v4f s1 = v4_sel(v4_sub(v4_mul(sin_t, cos_o), v4_mul(cos_t, sin_o)), zero, within_o);
-    // minus theta_u, clamped at 0
-    v4f c2 = v4_sel(v4_add(v4_mul(c1, cos_u), v4_mul(s1, sin_u)), one, v4_ge(c1, cos_u));
-    orient = v4_sel(zero, c2, v4_gt(c2, cos_e));
-  }
+  LtView v = lt_view_v(l, P);
+  v4f d2c = v4_max(v4_max(v.d2, v4_mul(v4_mul(l->r, l->r), v4_splat(0.25f))), v4_splat(1e-36f));
   // incidence at P
   v4f cos_i = one;
   if (N.x != 0.0f || N.y != 0.0f || N.z != 0.0f) {
     v4f nx = v4_splat(N.x), ny = v4_splat(N.y), nz = v4_splat(N.z);
-    v4f ci = v4_mul(v4_add(v4_add(v4_mul(dx, nx), v4_mul(dy, ny)), v4_mul(dz, nz)), inv_d);
-    v4f si = v4_min(v4_mul(lt_vcross_len(nx, ny, nz, dx, dy, dz), inv_d), one);
-    cos_i = v4_sel(v4_add(v4_mul(ci, cos_u), v4_mul(si, sin_u)), one, v4_ge(ci, cos_u));
+    v4f ci = v4_mul(v4_add(v4_add(v4_mul(v.dx, nx), v4_mul(v.dy, ny)), v4_mul(v.dz, nz)), v.inv_d);
+    v4f si = v4_min(v4_mul(lt_vcross_len(nx, ny, nz, v.dx, v.dy, v.dz), v.inv_d), one);
+    cos_i = v4_sel(v4_add(v4_mul(ci, v.cos_u), v4_mul(si, v.sin_u)), one, v4_ge(ci, v.cos_u));
     cos_i = v4_max(cos_i, zero);
   }
-  v4m alive = v4_gt(energy, zero);
-  float emax = v4_hmax(energy);
+  v4m alive = v4_gt(l->energy, zero);
+  float emax = v4_hmax(l->energy);
   float dmin2 = v4_hmin(v4_sel(v4_splat(3.0e38f), d2c, alive));
   float inv_emax = emax > 0.0f ? 1.0f / emax : 0.0f;
-  v4f e = v4_mul(energy, v4_splat(inv_emax));
+  v4f e = v4_mul(l->energy, v4_splat(inv_emax));
   v4f g = v4_div(v4_splat(dmin2), d2c);
-  v4f oc = v4_mul(orient, cos_i);
+  v4f oc = v4_mul(v.orient, cos_i);
   v4f imp = v4_mul(v4_mul(e, g), oc);
-  v4m contributes = v4_and(v4_and(alive, v4_gt(oc, zero)), front);
+  v4m contributes = v4_and(v4_and(alive, v4_gt(oc, zero)), v.front);
   v4f res = v4_sel(zero, v4_max(imp, v4_splat(LT_IMPORTANCE_FLOOR)), contributes);
   // No lane can contribute but some has energy (bounds of the parent were looser than those of
   // its children): rank by energy and distance alone, so a descent never dead-ends and the pmf
@@ -109,38 +137,47 @@ LT_HOT v4f lt_importance_v(v4f cx, v4f cy, v4f cz, v4f r, v4f ax, v4f ay, v4f az
 LT_HOT float4 lt_importance4(float4 cx, float4 cy, float4 cz, float4 r, float4 ax, float4 ay,
                              float4 az, float4 cos_o, float4 cos_e, float4 energy, float3 P,
                              float3 N) {
-  return v4_to_f4(lt_importance_v(v4_from_f4(cx), v4_from_f4(cy), v4_from_f4(cz), v4_from_f4(r),
-                                  v4_from_f4(ax), v4_from_f4(ay), v4_from_f4(az), v4_from_f4(cos_o),
-                                  v4_from_f4(cos_e), v4_from_f4(energy), v4_splat(LT_PLANE_NONE), P,
-                                  N, 1));
+  LtLanes l;
+  l.cx = v4_from_f4(cx);
+  l.cy = v4_from_f4(cy);
+  l.cz = v4_from_f4(cz);
+  l.r = v4_from_f4(r);
+  l.ax = v4_from_f4(ax);
+  l.ay = v4_from_f4(ay);
+  l.az = v4_from_f4(az);
+  l.cos_o = v4_from_f4(cos_o);
+  l.cos_e = v4_from_f4(cos_e);
+  l.energy = v4_from_f4(energy);
+  l.plane_h = v4_splat(LT_PLANE_NONE);
+  return v4_to_f4(lt_importance_v(&l, P, N, 1));
 }
 
+// Under LT_TERMS_DISTANCE (the orientation ablation) every cone is the full sphere and bounds
 // every direction (cos theta' = 1), N = 0 drops the receiver's incidence term, and no half-space
 // bound culls (it is an orientation term too).
-INLINE void lt_without_orientation(const LtTree* t, v4f* cos_o, v4f* cos_e, v4f* plane_h,
-                                   float3* N) {
+INLINE void lt_without_orientation(const LtTree* t, LtLanes* l, float3* N) {
   if (t->root_info.w == LT_TERMS_FULL) return;
-  *cos_o = v4_splat(-1.0f);
-  *cos_e = v4_splat(-1.0f);
-  *plane_h = v4_splat(LT_PLANE_NONE);
+  l->cos_o = v4_splat(-1.0f);
+  l->cos_e = v4_splat(-1.0f);
+  l->plane_h = v4_splat(LT_PLANE_NONE);
   *N = make_float3(0.0f, 0.0f, 0.0f);
 }
 
 // The cone axes of four lanes from their octahedral bits, decoded only if some lane's cone is not
-// the full sphere (cos_o = -1): lt_importance_v ignores the axes of four full-sphere lanes.
-LT_HOT void lt_decode_axes(v4f bits, v4f cos_o, v4f* ax, v4f* ay, v4f* az) {
-  if (v4_all(v4_le(cos_o, v4_splat(-1.0f)))) {
-    *ax = v4_splat(0.0f);
-    *ay = *ax;
-    *az = *ax;
+// the full sphere (cos_o = -1): lt_view_v ignores the axes of four full-sphere lanes.
+LT_HOT void lt_decode_axes(v4f bits, LtLanes* l) {
+  if (v4_all(v4_le(l->cos_o, v4_splat(-1.0f)))) {
+    l->ax = v4_splat(0.0f);
+    l->ay = l->ax;
+    l->az = l->ax;
     return;
   }
-  lt_oct_decode_v(v4_lo16(bits), v4_hi16(bits), ax, ay, az);
+  lt_oct_decode_v(v4_lo16(bits), v4_hi16(bits), &l->ax, &l->ay, &l->az);
 }
 
-// Importance of the (up to four) emitters of a leaf, from their emitter records (`fallback`: see
-// lt_importance_v).
-LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N, int fallback) {
+// The (up to four) emitters of a leaf as lanes, from their emitter records; *N is cleared under
+// the orientation ablation.
+LT_HOT LtLanes lt_leaf_lanes(const LtTree* t, int code, float3* N) {
   int count = lt_leaf_count(code);
   GLOBAL const float4* e = lt_emitter_records(t, lt_leaf_first(code));
   v4f zero = v4_splat(0.0f);
@@ -160,38 +197,60 @@ LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N
   }
   v4_transpose(a0, a1, a2, a3); // centre x, y, z, radius
   v4_transpose(b0, b1, b2, b3); // axis bits, q, energy, light
+  LtLanes l;
+  l.cx = a0;
+  l.cy = a1;
+  l.cz = a2;
+  l.r = a3;
+  l.energy = b2;
   v4m spot = v4_gt(b1, v4_splat(1.5f));
   v4m plane = v4_lt(b1, v4_splat(-1.5f)); // one-sided planar: q = -2 - h / r
-  v4f cos_o = v4_sel(v4_sel(b1, v4_splat(1.0f), spot), v4_splat(LT_PLANE_COS_O), plane);
-  v4f cos_e = v4_sel(zero, v4_sub(b1, v4_splat(2.0f)), spot);
-  v4f plane_h = v4_sel(v4_splat(LT_PLANE_NONE), v4_mul(v4_sub(v4_splat(-2.0f), b1), a3), plane);
-  lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
-  v4f ax, ay, az;
-  lt_decode_axes(b0, cos_o, &ax, &ay, &az);
-  return v4_to_f4(
-      lt_importance_v(a0, a1, a2, a3, ax, ay, az, cos_o, cos_e, b2, plane_h, P, N, fallback));
+  l.cos_o = v4_sel(v4_sel(b1, v4_splat(1.0f), spot), v4_splat(LT_PLANE_COS_O), plane);
+  l.cos_e = v4_sel(zero, v4_sub(b1, v4_splat(2.0f)), spot);
+  l.plane_h = v4_sel(v4_splat(LT_PLANE_NONE), v4_mul(v4_sub(v4_splat(-2.0f), b1), a3), plane);
+  lt_without_orientation(t, &l, N);
+  lt_decode_axes(b0, &l);
+  return l;
+}
+
+// The four children of a node as lanes; *N is cleared under the orientation ablation.
+LT_HOT LtLanes lt_node_lanes(const LtTree* t, int node, float3* N) {
+  GLOBAL const float4* n = t->nodes + node * LT_NODE_F4;
+  LtLanes l;
+  l.cx = v4_load(n + LT_CX);
+  l.cy = v4_load(n + LT_CY);
+  l.cz = v4_load(n + LT_CZ);
+  l.r = v4_load(n + LT_R);
+  l.energy = v4_load(n + LT_ENERGY);
+  v4f cos_o = v4_load(n + LT_COS_O);
+  v4f k16 = v4_lo16(v4_load(n + LT_CE_CV2));
+  v4m plane = v4_gt(cos_o, v4_splat(1.5f)); // LT_PLANE_FLAG: k16 is the plane offset
+  l.cos_e = v4_sel(v4_mul(k16, v4_splat(LT_U16_SCALE)), v4_splat(0.0f), plane);
+  l.plane_h =
+      v4_sel(v4_splat(LT_PLANE_NONE),
+             v4_mul(v4_sub(k16, v4_splat(32768.0f)), v4_mul(l.r, v4_splat(LT_PLANE_H_UNIT))), plane);
+  l.cos_o = v4_sel(cos_o, v4_splat(LT_PLANE_COS_O), plane);
+  lt_without_orientation(t, &l, N);
+  lt_decode_axes(v4_load(n + LT_AXIS), &l);
+  return l;
+}
+// The lanes below `code`, a node or a leaf.
+LT_HOT LtLanes lt_code_lanes4(const LtTree* t, int code, float3* N) {
+  return code >= 0 ? lt_node_lanes(t, code, N) : lt_leaf_lanes(t, code, N);
+}
+
+// Importance of the (up to four) emitters of a leaf (`fallback`: see lt_importance_v).
+LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N, int fallback) {
+  LtLanes l = lt_leaf_lanes(t, code, &N);
+  return v4_to_f4(lt_importance_v(&l, P, N, fallback));
 }
 LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) {
   return lt_leaf_importance_f(t, code, P, N, 1);
 }
 
 LT_HOT float4 lt_node_importance_f(const LtTree* t, int node, float3 P, float3 N, int fallback) {
-  GLOBAL const float4* n = t->nodes + node * LT_NODE_F4;
-  v4f r = v4_load(n + LT_R);
-  v4f cos_o = v4_load(n + LT_COS_O);
-  v4f k16 = v4_lo16(v4_load(n + LT_CE_CV2));
-  v4m plane = v4_gt(cos_o, v4_splat(1.5f)); // LT_PLANE_FLAG: k16 is the plane offset
-  v4f cos_e = v4_sel(v4_mul(k16, v4_splat(LT_U16_SCALE)), v4_splat(0.0f), plane);
-  v4f plane_h =
-      v4_sel(v4_splat(LT_PLANE_NONE),
-             v4_mul(v4_sub(k16, v4_splat(32768.0f)), v4_mul(r, v4_splat(LT_PLANE_H_UNIT))), plane);
-  cos_o = v4_sel(cos_o, v4_splat(LT_PLANE_COS_O), plane);
-  lt_without_orientation(t, &cos_o, &cos_e, &plane_h, &N);
-  v4f ax, ay, az;
-  lt_decode_axes(v4_load(n + LT_AXIS), cos_o, &ax, &ay, &az);
-  return v4_to_f4(lt_importance_v(v4_load(n + LT_CX), v4_load(n + LT_CY), v4_load(n + LT_CZ), r, ax,
-                                  ay, az, cos_o, cos_e, v4_load(n + LT_ENERGY), plane_h, P, N,
-                                  fallback));
+  LtLanes l = lt_node_lanes(t, node, &N);
+  return v4_to_f4(lt_importance_v(&l, P, N, fallback));
 }
 LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) {
   return lt_node_importance_f(t, node, P, N, 1);

@@ -48,6 +48,9 @@ struct RenderArgs {
   std::optional<int> max_depth;
   bool no_orientation = false;
   bool no_mis = false;
+  std::optional<float> brdf_delta, brdf_lambda;
+  std::optional<int> brdf_n_max;
+  bool brdf_equal = false;
   std::string out, png, device, stats_json, heatmap;
   bool stats = false;
 };
@@ -151,6 +154,14 @@ std::string sampler_summary(const IntegratorSettings& in, bool orientation_term)
     parts.push_back(fmt::format("threshold {}", in.split_threshold));
     parts.push_back(fmt::format("max cut {}", in.max_cut));
   }
+  if (in.light_sampler == "brdf-mis" || in.light_sampler == "brdf-oriented")
+    parts.push_back(fmt::format("delta {}", in.brdf_delta));
+  if (in.light_sampler == "brdf-mis") {
+    if (in.brdf_adaptive)
+      parts.push_back(fmt::format("N_max {}, lambda {}", in.brdf_n_max, in.brdf_lambda));
+    else
+      parts.push_back("equal allocation");
+  }
   if (!orientation_term) parts.push_back("no orientation");
   if (!in.mis) parts.push_back("no MIS");
   if (parts.empty()) return s;
@@ -191,6 +202,24 @@ int run_render(const RenderArgs& args) {
         "--no-orientation: applies to the tree samplers only (tree, tree-split), not {}",
         scene.integrator.light_sampler));
   if (args.no_mis) scene.integrator.mis = false;
+  if (args.brdf_delta) {
+    if (!(*args.brdf_delta >= 0.0f && *args.brdf_delta <= 1e3f))
+      throw SceneError(fmt::format("--brdf-delta: must be in [0, 1000], got {}", *args.brdf_delta));
+    scene.integrator.brdf_delta = *args.brdf_delta;
+  }
+  if (args.brdf_n_max) {
+    if (*args.brdf_n_max < 1 || *args.brdf_n_max > kMaxBrdfSamples)
+      throw SceneError(fmt::format("--brdf-nmax: must be in [1, {}], got {}", kMaxBrdfSamples,
+                                   *args.brdf_n_max));
+    scene.integrator.brdf_n_max = *args.brdf_n_max;
+  }
+  if (args.brdf_lambda) {
+    if (!(*args.brdf_lambda >= 1e-3f && *args.brdf_lambda <= 1e6f))
+      throw SceneError(
+          fmt::format("--brdf-lambda: must be in [0.001, 1e6], got {}", *args.brdf_lambda));
+    scene.integrator.brdf_lambda = *args.brdf_lambda;
+  }
+  if (args.brdf_equal) scene.integrator.brdf_adaptive = false;
 
   auto [exr, png] = output_paths(args);
   check_writable(exr, args.out.empty() ? "output" : "--out");
@@ -224,6 +253,10 @@ int run_render(const RenderArgs& args) {
   ropt.max_cut = scene.integrator.max_cut;
   ropt.orientation_term = !args.no_orientation;
   ropt.mis = scene.integrator.mis;
+  ropt.brdf.delta = scene.integrator.brdf_delta;
+  ropt.brdf.n_max = scene.integrator.brdf_n_max;
+  ropt.brdf.lambda = scene.integrator.brdf_lambda;
+  ropt.brdf.adaptive = scene.integrator.brdf_adaptive;
   Renderer renderer(rt, scene, ropt);
   ProgressBar bar;
   RenderSettings settings;
@@ -276,6 +309,10 @@ int run_render(const RenderArgs& args) {
     j["max_cut"] = scene.integrator.max_cut;
     j["max_depth"] = scene.integrator.max_depth;
     j["mis"] = scene.integrator.mis;
+    j["brdf_delta"] = scene.integrator.brdf_delta;
+    j["brdf_n_max"] = scene.integrator.brdf_n_max;
+    j["brdf_lambda"] = scene.integrator.brdf_lambda;
+    j["brdf_adaptive"] = scene.integrator.brdf_adaptive;
     j["spp"] = scene.integrator.spp;
     j["film"] = {scene.film.width, scene.film.height};
     j["lights"] = scene.lights.size();
@@ -348,6 +385,15 @@ int main(int argc, char** argv) {
   render->add_flag("--no-orientation", rargs.no_orientation,
                    "Tree samplers: rank clusters by energy / distance^2 only (ablation of the "
                    "orientation terms, paper Fig. 15-16)");
+  render->add_option("--brdf-delta", rargs.brdf_delta,
+                     "brdf-mis/brdf-oriented: split clusters while the BRDF cap integral exceeds "
+                     "this (default 0.5)");
+  render->add_option("--brdf-nmax", rargs.brdf_n_max,
+                     "brdf-mis: BRDF-aware samples per glossy point at most (default 50)");
+  render->add_option("--brdf-lambda", rargs.brdf_lambda,
+                     "brdf-mis: weight of BSDF hits in the adaptive allocation (default 10)");
+  render->add_flag("--brdf-equal", rargs.brdf_equal,
+                   "brdf-mis: one sample of each technique instead of adaptive allocation");
   render->add_flag("--no-mis", rargs.no_mis,
                    "No multiple importance sampling: light sampling alone gives direct light at "
                    "non-delta vertices, and BSDF-sampled rays that hit an emitter count only after "

@@ -151,10 +151,14 @@ public:
   }
 };
 
+// Also brdf-mis and brdf-oriented: this interface knows a point by P and N only, with no BRDF, and
+// at points without a glossy BRDF both are tree-split (cl/integrator/brdf_mis.h).
 class TreeSplitSampler final : public TreeSamplerBase {
 public:
-  using TreeSamplerBase::TreeSamplerBase;
-  const char* name() const override { return "tree-split"; }
+  TreeSplitSampler(const std::vector<Light>& lights, const LightSamplerOptions& opt,
+                   const char* name = "tree-split")
+      : TreeSamplerBase(lights, opt), name_(name) {}
+  const char* name() const override { return name_; }
   void sample(float3 P, float3 N, Rng& rng, std::vector<LightPick>& out) const override {
     if (degenerate()) return sample_uniform(rng, out);
     LtTree t = view();
@@ -166,6 +170,9 @@ public:
     LtTree t = view();
     return lt_pmf_split(&t, P, N, light, opt_.split_threshold, uint(opt_.max_cut));
   }
+
+private:
+  const char* name_;
 };
 
 } // namespace
@@ -239,6 +246,10 @@ std::unique_ptr<LightSampler> make_light_sampler(const std::string& name,
     return std::make_unique<ExhaustiveSampler>(lights);
   case SAMPLER_BSDF:
     return std::make_unique<BsdfSampler>(lights);
+  case SAMPLER_BRDF_MIS:
+  case SAMPLER_BRDF_ORIENTED:
+    return std::make_unique<TreeSplitSampler>(lights, opt,
+                                              kLightSamplerNames[light_sampler_kind(name)].data());
   default:
     break;
   }

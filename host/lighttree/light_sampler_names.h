@@ -10,15 +10,19 @@
 
 namespace canopy {
 
-inline constexpr std::array<std::string_view, 6> kLightSamplerNames = {
-    "uniform", "power", "tree", "tree-split", "exhaustive", "bsdf"};
-static_assert(kLightSamplerNames.size() == SAMPLER_BSDF + 1, "one name per SAMPLER_* kind");
+inline constexpr std::array<std::string_view, 8> kLightSamplerNames = {
+    "uniform", "power",      "tree",    "tree-split", "exhaustive",
+    "bsdf",    "brdf-mis", "brdf-oriented"};
+static_assert(kLightSamplerNames.size() == SAMPLER_BRDF_ORIENTED + 1,
+              "one name per SAMPLER_* kind");
 static_assert(kLightSamplerNames[SAMPLER_UNIFORM] == "uniform" &&
               kLightSamplerNames[SAMPLER_POWER] == "power" &&
               kLightSamplerNames[SAMPLER_TREE] == "tree" &&
               kLightSamplerNames[SAMPLER_TREE_SPLIT] == "tree-split" &&
               kLightSamplerNames[SAMPLER_EXHAUSTIVE] == "exhaustive" &&
-              kLightSamplerNames[SAMPLER_BSDF] == "bsdf");
+              kLightSamplerNames[SAMPLER_BSDF] == "bsdf" &&
+              kLightSamplerNames[SAMPLER_BRDF_MIS] == "brdf-mis" &&
+              kLightSamplerNames[SAMPLER_BRDF_ORIENTED] == "brdf-oriented");
 
 // The SAMPLER_* kind named `name`, or -1 if no sampler has that name.
 constexpr int light_sampler_kind(std::string_view name) {

@@ -59,6 +59,7 @@ void upload_light_sampler(const cl::Context& ctx, const std::vector<Light>& ligh
   d.root_info = sampler.tree.root_info;
   d.split_threshold = sampler.threshold;
   d.max_cut = sampler.root_budget();
+  d.brdf = sampler.brdf;
 }
 
 void DeviceScene::set_args(KernelArgs& args) const {
@@ -78,6 +79,10 @@ void DeviceScene::set_args(KernelArgs& args) const {
   args.set("lt_root_info", root_info);
   args.set("split_threshold", cl_float(split_threshold));
   args.set("max_cut", cl_uint(max_cut));
+  args.set("brdf_delta", cl_float(brdf.delta));
+  args.set("brdf_lambda", cl_float(brdf.lambda));
+  args.set("brdf_nmax", cl_int(brdf.n_max));
+  args.set("brdf_adaptive", cl_int(brdf.adaptive ? 1 : 0));
 }
 
 } // namespace canopy

@@ -34,6 +34,7 @@ struct DeviceScene {
   float4 root_sphere{0, 0, 0, 0}, root_info{0, 0, 0, 0};
   float split_threshold = 0.0f;
   uint32_t max_cut = 1;
+  BrdfSettings brdf;
 
   // Names every buffer and scalar above as the kernels' arguments (SCENE_PARAMS,
   // LIGHT_SAMPLER_PARAMS). Buffers not uploaded (e.g. no geometry) stay without a value, so a

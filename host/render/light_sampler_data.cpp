@@ -10,18 +10,21 @@ namespace canopy {
 
 LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const std::string& name,
                                          float split_threshold, int max_cut,
-                                         bool orientation_term) {
+                                         bool orientation_term, const BrdfSettings& brdf) {
   LightSamplerData d;
   d.kind = light_sampler_from_name(name);
+  d.brdf = brdf;
   d.threshold = split_threshold;
   const uint32_t n = uint32_t(lights.size());
   if (d.kind == SAMPLER_EXHAUSTIVE) {
     d.threshold = 1.0f;                   // split every cluster ...
     d.max_cut = std::max<uint32_t>(1, n); // ... so a cut holds every light (root_budget())
-  } else if (d.kind == SAMPLER_TREE_SPLIT) {
+  } else if (d.kind == SAMPLER_TREE_SPLIT || d.kind == SAMPLER_BRDF_MIS ||
+             d.kind == SAMPLER_BRDF_ORIENTED) {
     d.max_cut = uint32_t(std::clamp(max_cut, 1, int(std::max<uint32_t>(1, n))));
   }
-  if (d.kind == SAMPLER_TREE || d.kind == SAMPLER_TREE_SPLIT || d.kind == SAMPLER_EXHAUSTIVE) {
+  if (d.kind == SAMPLER_TREE || d.kind == SAMPLER_TREE_SPLIT || d.kind == SAMPLER_EXHAUSTIVE ||
+      d.kind == SAMPLER_BRDF_MIS || d.kind == SAMPLER_BRDF_ORIENTED) {
     auto t0 = std::chrono::steady_clock::now();
     d.tree = build_light_tree(lights);
     d.tree.set_orientation_term(orientation_term);
@@ -41,7 +44,8 @@ LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const
   return d;
 }
 
-LightSamplerCtx LightSamplerData::host_view(const std::vector<Light>& lights) const {
+LightSamplerCtx LightSamplerData::host_view(const std::vector<Light>& lights,
+                                            float2* brdf_cut) const {
   LightSamplerCtx ls{};
   ls.kind = kind;
   ls.light_count = int(lights.size());
@@ -52,6 +56,11 @@ LightSamplerCtx LightSamplerData::host_view(const std::vector<Light>& lights) co
   ls.tree = tree.view(lights.data());
   ls.threshold = threshold;
   ls.max_cut = root_budget();
+  ls.brdf_cut = brdf_cut;
+  ls.brdf_delta = brdf.delta;
+  ls.brdf_lambda = brdf.lambda;
+  ls.brdf_nmax = brdf.n_max;
+  ls.brdf_adaptive = brdf.adaptive ? 1 : 0;
   return ls;
 }
 

@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include "integrator/brdf_mis.h"
 #include "render/camera.h"
 #include "render/memory_budget.h"
 
@@ -9,6 +10,7 @@
 #include <cfloat>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace canopy {
@@ -27,6 +29,7 @@ cl::Buffer device_buffer(const cl::Context& ctx, size_t bytes) {
 const std::vector<std::string> kKernelFiles = {
     "kernels/compact.cl",       "kernels/generate.cl",   "kernels/intersect_closest.cl",
     "kernels/shade_surface.cl", "kernels/light_pick.cl", "kernels/intersect_shadow.cl",
+    "kernels/brdf_mis.cl",
     "kernels/accumulate.cl"};
 
 constexpr int kScanBlock = 256;
@@ -126,7 +129,7 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
     materials_.push_back(m.gpu);
   geometry_ = build_scene_geometry(scene, materials_);
   sampler_ = make_light_sampler_data(scene.lights, options.light_sampler, options.split_threshold,
-                                     options.max_cut, options.orientation_term);
+                                     options.max_cut, options.orientation_term, options.brdf);
   stats_.light_tree_seconds = sampler_.tree_build_seconds;
   stats_.build_seconds = seconds_since(t0);
 
@@ -144,6 +147,7 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_.kind)
                                                  : scene_features(scene, sampler_.kind);
   features.mis = options.mis;
+  brdf_stages_ = sampler_.brdf_oriented() && (features.material_conductor || features.material_plastic);
   stats_.kernel_options = features.build_options();
   program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
@@ -170,7 +174,8 @@ Film Renderer::render(const RenderSettings& settings) {
                 {"film_sumsq", uint64_t(npix) * sizeof(double4)},
                 {"film_counts", uint64_t(npix) * sizeof(double2)},
                 {"shadow_stage", 4 * uint64_t(split_cap) * sizeof(ShadowItem)},
-                {"child_stage", 4 * uint64_t(split_cap) * sizeof(SplitItem)}},
+                {"child_stage", 4 * uint64_t(split_cap) * sizeof(SplitItem)},
+                {"brdf_stage", uint64_t(brdf_stages_ ? W : 1) * BRDF_MAX_BATCH * sizeof(BrdfItem)}},
                {{"film (host copy)", uint64_t(npix) * (2 * sizeof(double4) + sizeof(double2))},
                 {"image", uint64_t(npix) * 3 * sizeof(float)}},
                printable(scene_.path.string(), 1024));
@@ -205,6 +210,13 @@ Film Renderer::render(const RenderSettings& settings) {
   buffer("shadow_stage", 4 * split_cap * sizeof(ShadowItem));
   buffer("shadow_items", split_cap * sizeof(ShadowItem));
   cl::Buffer counts_pick = buffer("counts_pick", split_cap * sizeof(cl_int2));
+  // BRDF-oriented sampling (brdf_mis.cl): each path's cut, one round's staged and compacted items.
+  const size_t brdf_paths = brdf_stages_ ? W : 1;
+  buffer("brdf_cut", brdf_paths * LT_BRDF_MAX_CUT * sizeof(float2));
+  buffer("brdf_stage", brdf_paths * BRDF_MAX_BATCH * sizeof(BrdfItem));
+  buffer("brdf_items", brdf_paths * BRDF_MAX_BATCH * sizeof(BrdfItem));
+  cl::Buffer counts_brdf = buffer("counts_brdf", brdf_paths * sizeof(cl_int2));
+  cl::Buffer brdf_counters = buffer("brdf_counters", 3 * sizeof(cl_int));
   buffer("offsets", split_cap * sizeof(cl_int2));
   buffer("block_sums", (split_cap / kScanBlock + 2) * sizeof(cl_int2));
   cl::Buffer totals = buffer("totals", 2 * sizeof(cl_int));
@@ -221,6 +233,7 @@ Film Renderer::render(const RenderSettings& settings) {
   // (at most W * max_depth events) and are added into the 64-bit stats after each wave: a whole
   // render at 2^24 spp has more than 2^31 samples.
   auto reset_counters = [&] {
+    q.enqueueFillBuffer(brdf_counters, cl_int(0), 0, 3 * sizeof(cl_int));
     q.enqueueFillBuffer(nonfinite, cl_int(0), 0, sizeof(cl_int));
     q.enqueueFillBuffer(histogram, cl_int(0), 0, kCutBins * sizeof(cl_int));
   };
@@ -239,6 +252,17 @@ Film Renderer::render(const RenderSettings& settings) {
   BoundKernel k_accumulate(program_, "accumulate", args);
   BoundKernel k_scan_blocks(program_, "scan_blocks", args);
   BoundKernel k_scan_sums(program_, "scan_block_sums", args);
+  std::optional<BoundKernel> k_brdf_cut, k_brdf_sample, k_brdf_scatter, k_brdf_trace, k_brdf_sum;
+  if (brdf_stages_) {
+    k_brdf_cut.emplace(program_, "brdf_cut", args);
+    k_brdf_sample.emplace(program_, "brdf_sample", args);
+    k_brdf_scatter.emplace(program_, "scatter_brdf", args);
+    k_brdf_trace.emplace(program_, "brdf_trace", args);
+    k_brdf_sum.emplace(program_, "brdf_accumulate", args);
+  }
+  // Rounds of BRDF-aware samples per bounce: enough for the largest N (brdf_mis.h).
+  const int brdf_rounds = brdf_rounds_for(
+      sampler_.kind == SAMPLER_BRDF_ORIENTED ? 1 : (sampler_.brdf.adaptive ? sampler_.brdf.n_max : 2));
 
   std::vector<std::pair<const char*, cl::Event>> events;
   // Arguments are bound (and checked) even when there is no work.
@@ -282,6 +306,9 @@ Film Renderer::render(const RenderSettings& settings) {
           size_t(count));
       stats_.shading_points += uint64_t(shade_count);
       q.enqueueFillBuffer(cut_size, cl_int(0), 0, W * sizeof(cl_int));
+      // The BRDF-oriented cuts first: tree light samples at glossy points are weighted with them.
+      if (brdf_stages_)
+        run("brdf_cut", k_brdf_cut->bind({{"queue", *q_in}, {"count", count}}), size_t(count));
 
       // Split passes: each pass consumes one level of the cut (DESIGN §4).
       cl::Buffer* s_in = &split_a;
@@ -299,6 +326,20 @@ Film Renderer::render(const RenderSettings& settings) {
         std::swap(s_in, s_out);
         n = n_children;
       }
+      // Rounds of BRDF-aware samples at glossy points (Alg. 1 in batches, brdf_mis.h).
+      for (int round = 0; brdf_stages_ && round < brdf_rounds; ++round) {
+        run("brdf_sample",
+            k_brdf_sample->bind({{"queue", *q_in}, {"count", count}, {"brdf_round", round}}),
+            size_t(count));
+        auto [n_items, unused] = scan(counts_brdf, count);
+        (void)unused;
+        if (n_items == 0) continue;
+        run("scatter", k_brdf_scatter->bind({{"count", count}, {"counts", counts_brdf}}),
+            size_t(count));
+        run("brdf_trace", k_brdf_trace->bind({{"count", n_items}}), size_t(n_items));
+        run("brdf_accumulate", k_brdf_sum->bind({{"count", n_items}}), size_t(n_items));
+        stats_.brdf_rays += uint64_t(n_items);
+      }
       run("cut_histogram", k_histogram.bind({{"queue", *q_in}, {"count", count}}), size_t(count));
 
       std::swap(q_in, q_out);
@@ -315,6 +356,13 @@ Film Renderer::render(const RenderSettings& settings) {
     q.enqueueReadBuffer(nonfinite, CL_FALSE, 0, sizeof(nf), &nf);
     q.enqueueReadBuffer(histogram, CL_TRUE, 0, kCutBins * sizeof(cl_int), hist.data());
     stats_.nonfinite_samples += uint64_t(uint32_t(nf));
+    if (brdf_stages_) {
+      cl_int bc[3];
+      q.enqueueReadBuffer(brdf_counters, CL_TRUE, 0, sizeof(bc), bc);
+      stats_.glossy_points += uint64_t(uint32_t(bc[0]));
+      stats_.brdf_cut_sum += uint64_t(uint32_t(bc[1]));
+      stats_.brdf_samples_sum += uint64_t(uint32_t(bc[2]));
+    }
     for (int k = 0; k < kCutBins; ++k)
       stats_.cut_size_histogram[size_t(k)] += uint64_t(uint32_t(hist[size_t(k)]));
     reset_counters();

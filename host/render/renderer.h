@@ -35,6 +35,10 @@ struct RenderStats {
   double render_seconds = 0.0;  // wall time of render()
   uint64_t samples = 0;
   uint64_t shading_points = 0; // surface hits shaded
+  // brdf-mis, brdf-oriented: glossy shading points, and the sums over them of the BRDF-oriented
+  // cut size and of the BRDF-aware sample count N (Liu et al. 2019, Table 1)
+  uint64_t glossy_points = 0, brdf_cut_sum = 0, brdf_samples_sum = 0;
+  uint64_t brdf_rays = 0; // rays of the BRDF-aware samples (shadow rays and BSDF probes)
   uint64_t shadow_rays = 0;
   std::vector<uint64_t> cut_size_histogram; // shading points by number of cut members
   std::string kernel_options;               // the -D options the kernels were compiled with
@@ -86,6 +90,7 @@ struct RendererOptions {
   int max_cut = kDefaultMaxCut;       // cut size cap per shading point (tree-split)
   bool orientation_term = true;       // tree samplers: false = E / d^2 importance (ablation)
   bool mis = true;                    // false: no MIS (light sampling alone for non-delta bounces)
+  BrdfSettings brdf;                  // brdf-mis, brdf-oriented
   bool all_features = false;          // compile every kernel feature (tests)
   size_t split_queue_items = 1 << 20; // split-queue capacity per wave
 };
@@ -118,6 +123,7 @@ private:
   LightSamplerData sampler_;
   RenderStats stats_;
   cl::Program program_;
+  bool brdf_stages_ = false; // brdf-mis / brdf-oriented on a scene with a glossy material
   DeviceScene device_;
   cl::Buffer camera_;
 };

@@ -36,6 +36,12 @@ nlohmann::json stats_to_json(const RenderStats& s, const RunTimings& run) {
   j["overflowed_pixels"] = s.overflowed_pixels; // written as +-FLT_MAX
   j["emission_exponent"] = s.emission_exponent; // the device rendered emission * 2^-k
   j["kernel_options"] = s.kernel_options;
+  // brdf-mis / brdf-oriented, over glossy shading points (Liu et al. 2019, Table 1 columns)
+  j["glossy_points"] = s.glossy_points;
+  j["brdf_mean_cut"] = s.glossy_points ? double(s.brdf_cut_sum) / double(s.glossy_points) : 0.0;
+  j["brdf_mean_samples"] =
+      s.glossy_points ? double(s.brdf_samples_sum) / double(s.glossy_points) : 0.0;
+  j["brdf_rays"] = s.brdf_rays;
   nlohmann::json stages = nlohmann::json::object();
   for (const auto& [name, st] : s.stages)
     stages[name] = {{"seconds", st.seconds},
@@ -78,6 +84,11 @@ std::string stats_to_table(const RenderStats& s, const RunTimings& run) {
   out += fmt::format("cut members {}{} ({:.1f}% yield a shadow ray)\n",
                      ct.exact ? "" : ">= ", ct.members,
                      ct.members ? 100.0 * double(s.shadow_rays) / double(ct.members) : 0.0);
+  if (s.glossy_points)
+    out += fmt::format("glossy points {}: BRDF-oriented cut {:.2f} clusters, {:.2f} BRDF-aware "
+                       "samples per point on average ({} rays)\n",
+                       s.glossy_points, double(s.brdf_cut_sum) / double(s.glossy_points),
+                       double(s.brdf_samples_sum) / double(s.glossy_points), s.brdf_rays);
   out += "cut sizes (shading points by cut members):";
   for (size_t k = 0; k < s.cut_size_histogram.size(); ++k)
     if (s.cut_size_histogram[k])

@@ -74,14 +74,23 @@ struct FilmSettings {
 struct IntegratorSettings {
   int spp = 16;      // samples per pixel, 1 .. kMaxSpp
   int max_depth = 5; // path vertices after the camera hit: 1 = direct light only
-  std::string light_sampler = "tree-split"; // uniform | power | tree | tree-split | exhaustive
+  std::string light_sampler = "tree-split"; // a name of kLightSamplerNames
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD; // adaptive splitting threshold in [0, 1]
   int max_cut = kDefaultMaxCut; // tree-split: at most this many lights per shading point
   uint32_t seed = 1;
   // MIS (power heuristic) between light and BSDF sampling; false: light sampling alone counts
   // emission from non-delta bounces (the ablation of docs/results.md).
   bool mis = true;
+  // brdf-mis / brdf-oriented (Liu et al. 2019; render/light_sampler_data.h BrdfSettings): the
+  // cut's split threshold on S_C, N_max, lambda, and adaptive allocation (false: equal).
+  float brdf_delta = 0.5f;
+  int brdf_n_max = 50;
+  float brdf_lambda = 10.0f;
+  bool brdf_adaptive = true;
 };
+// Largest brdf_n_max: it bounds the BRDF-aware samples of one shading point (and the rounds of
+// kernels per bounce, log2 of it).
+inline constexpr int kMaxBrdfSamples = 1024;
 
 struct MaterialDesc {
   std::string name;

@@ -234,7 +234,8 @@ void parse_film(const JsonValue& v, FilmSettings& film) {
 
 void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
   auto o = v.as_object();
-  o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "max_cut", "seed", "mis"});
+  o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "max_cut", "seed", "mis",
+           "brdf_delta", "brdf_n_max", "brdf_lambda", "brdf_adaptive"});
   if (auto x = o.get("spp")) in.spp = int(x->as_int(1, kMaxSpp));
   if (auto x = o.get("max_depth")) in.max_depth = int(x->as_int(1, kMaxDepth));
   if (auto x = o.get("light_sampler")) in.light_sampler = x->as_enum(kLightSamplerNames);
@@ -242,6 +243,10 @@ void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
   if (auto x = o.get("max_cut")) in.max_cut = int(x->as_int(1, kMaxMaxCut));
   if (auto x = o.get("seed")) in.seed = uint32_t(x->as_int(0, 0xffffffffLL));
   if (auto x = o.get("mis")) in.mis = x->as_bool();
+  if (auto x = o.get("brdf_delta")) in.brdf_delta = x->as_float_in(0.0f, 1e3f);
+  if (auto x = o.get("brdf_n_max")) in.brdf_n_max = int(x->as_int(1, kMaxBrdfSamples));
+  if (auto x = o.get("brdf_lambda")) in.brdf_lambda = x->as_float_in(1e-3f, 1e6f);
+  if (auto x = o.get("brdf_adaptive")) in.brdf_adaptive = x->as_bool();
 }
 
 // One entry of "materials" (docs/scene-format.md, Materials). Roughness r becomes GGX alpha = r^2.

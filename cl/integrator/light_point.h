@@ -1,0 +1,60 @@
+// A light point sampled for a path's shading point, with the BRDF and the shadow ray towards it:
+// what tree light sampling (light_pick.h) and BRDF-oriented light sampling (brdf_mis.h) both make
+// of a chosen light. Compiles as OpenCL C and as C++.
+#ifndef CANOPY_INTEGRATOR_LIGHT_POINT_H
+#define CANOPY_INTEGRATOR_LIGHT_POINT_H
+
+#include "../bsdf/bsdf.h"
+#include "../light_sample.h"
+#include "../shading.h"
+#include "light_sampler.h"
+#include "path_state.h"
+
+// A light point sampled for the shading point of `path` from `light` and what it brings: the
+// unoccluded radiance times the BRDF and cosine, the BSDF's pdf for the direction, and the shadow
+// ray (P is already off the surface; the ray ends short of the light point by the float error of
+// that point's own coordinates and of the distance). Returns 0 if the point cannot contribute.
+typedef struct LightPoint {
+  LightSample s;
+  float3 f_cos; // f(wo, wi) cos(theta_s) (local shading frame)
+  float bsdf_pdf;
+  float4 origin, dir; // the shadow ray (dir.w: path)
+} LightPoint;
+
+INLINE int light_point_sample(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                              const PathBuffers* pb, int path, int light, float u1, float u2,
+                              LightPoint* lp) {
+  float3 P = xyz_of(pb->shade_P[path]);
+  float3 N = xyz_of(pb->shade_N[path]);
+  LightSample s = sample_light(&ls->lights[light], P, u1, u2);
+  // Light arriving from below the geometric surface would leak through it (shading normals).
+  if (!(s.pdf > 0.0f) || !(dot(N, s.wi) > 0.0f) || !(max3(s.Li) > 0.0f)) return 0;
+  float4 ns_m = pb->shade_Ns[path];
+  Material m = sc->materials[(int)float_as_uint_(ns_m.w)];
+  float3 Ns = xyz_of(ns_m);
+  float cos_s = dot(Ns, s.wi); // = the local frame's wi.z
+  if (!(cos_s > 0.0f)) return 0;
+  if (!HAS_MICROFACET || m.type == MATERIAL_DIFFUSE) {
+    // Lambertian needs no frame (the common case, and the only one of a diffuse-only kernel).
+    lp->f_cos =
+        diffuse_eval(&m, make_float3(0.0f, 0.0f, 1.0f), make_float3(0.0f, 0.0f, cos_s)) * cos_s;
+    lp->bsdf_pdf = diffuse_pdf(make_float3(0.0f, 0.0f, 1.0f), make_float3(0.0f, 0.0f, cos_s));
+  } else {
+    Frame fr = frame_from(Ns);
+    float3 wo = frame_to_local(&fr, xyz_of(pb->shade_wo[path]));
+    float3 wi = frame_to_local(&fr, s.wi);
+    lp->f_cos = bsdf_eval(&m, wo, wi) * cos_s;
+    lp->bsdf_pdf = bsdf_pdf(&m, wo, wi);
+  }
+  if (s.is_delta) lp->bsdf_pdf = 0.0f; // BSDF sampling never finds a point light
+  float3 to = s.x - P;
+  float dist = length(to);
+  if (!(dist > 0.0f)) return 0;
+  float tmax = dist - fp_gamma(6) * (max_abs3(s.x) + dist);
+  lp->origin = f4_from3(P, fmax(tmax, 0.0f));
+  lp->dir = f4_from3(to / dist, uint_as_float_((uint)path));
+  lp->s = s;
+  return 1;
+}
+
+#endif // CANOPY_INTEGRATOR_LIGHT_POINT_H
