@@ -48,8 +48,6 @@
 #define BRDF_MAX_BATCH 32
 // shade_f.w of a glossy point under a BRDF sampler (0 and 1: see path_state.h).
 #define BRDF_POINT_FLAG 2.0f
-// Upper bound of N_max (the scene/CLI parameter; it bounds the per-point work).
-#define BRDF_MAX_SAMPLES 1024
 
 // Samples drawn in round r: 1, 1, 2, 4, ..., BRDF_MAX_BATCH.
 INLINE int brdf_round_batch(int round) {
