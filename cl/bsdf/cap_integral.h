@@ -93,13 +93,13 @@ INLINE float cap_cosine_integral(float cos_w, float sin_w, float sin_r, float co
 }
 
 // Solid angle of the intersection of caps A (axis a, half-angle ra) and B (axis b, rb), each
-// given by its sine and cosine. Disjoint, nested and covering-the-sphere cases are exact; the lens
-// (the boundary circles cross at P, P') follows from Gauss-Bonnet: the two circular sectors
+// at most a hemisphere and given by its sine and cosine. Disjoint and nested cases are exact; the
+// lens (the boundary circles cross at P, P') follows from Gauss-Bonnet: the two circular sectors
 // c_a P P' and c_b P P' minus twice the spherical triangle (c_a, c_b, P),
 //   |A n B| = 2 phi_a (1 - cos ra) + 2 phi_b (1 - cos rb) - 2 E,
-// phi_a, phi_b the triangle's angles at c_a, c_b and E its spherical excess (this is Mazonka
-// 2012, "Solid angle of conical surfaces, polyhedral cones, and intersecting spherical caps",
-// Eq. 52, rearranged for float). With d the distance between the axes and
+// phi_a, phi_b the triangle's angles at c_a, c_b and E its spherical excess (Mazonka 2012,
+// "Solid angle of conical surfaces, polyhedral cones, and intersecting spherical caps", Eq. 52,
+// rearranged for float). With d the distance between the axes and
 // V = det(c_a, c_b, P) = sin ra sin d sin phi_a:
 //   sin ra sin d cos phi_a = cos rb - cos d cos ra,  sin rb sin d cos phi_b = cos ra - cos d cos
 //   rb, V^2 = (sin ra sin d)^2 - (cos rb - cos d cos ra)^2, tan(E / 2) = V / (1 + cos d + cos ra +
@@ -107,7 +107,7 @@ INLINE float cap_cosine_integral(float cos_w, float sin_w, float sin_r, float co
 // all angles by atan2 (accurate everywhere, unlike acos). For a cap smaller than 1e-3 rad the
 // sector and triangle terms cancel to O(r^2) from O(r) (relative error ~1e-7 / r), so the small
 // cap is cut by the chord through P P' instead (relative error O(r cot rb)).
-INLINE float cap_intersection_area(float3 a, float sa, float ca, float3 b, float sb, float cb) {
+INLINE float cap_lens_area(float3 a, float sa, float ca, float3 b, float sb, float cb) {
   float cd = clamp(dot(a, b), -1.0f, 1.0f);
   float sd = length(cross(a, b));
   float ra = atan2(sa, ca), rb = atan2(sb, cb), d = atan2(sd, cd);
@@ -115,15 +115,13 @@ INLINE float cap_intersection_area(float3 a, float sa, float ca, float3 b, float
   if (d >= ra + rb) return 0.0f;
   if (d + ra <= rb) return area_a;
   if (d + rb <= ra) return area_b;
-  if (ra + rb + d >= 2.0f * CANOPY_PI) return fmax(area_a + area_b - 4.0f * CANOPY_PI, 0.0f);
   float omc_a = cap_one_minus_cos(sa, ca), omc_b = cap_one_minus_cos(sb, cb);
   float x = (cb - cd) + cd * omc_a; // cos rb - cos d cos ra
   float y = (ca - cd) + cd * omc_b; // cos ra - cos d cos rb
   float h = sa * sd;
   float v = sqrt(fmax(0.0f, (h - x) * (h + x)));
   float phi_a = atan2(v, x), phi_b = atan2(v, y);
-  float r_small = fmin(ra, rb);
-  if (r_small < 1e-3f) {
+  if (fmin(ra, rb) < 1e-3f) {
     // The segment of the small cap on the other cap's side of the chord: (phi - sin phi cos phi)
     // / pi of its area (phi its half-angle at the centre, which atan2 gives for either cap).
     int a_small = ra <= rb;
@@ -135,6 +133,19 @@ INLINE float cap_intersection_area(float3 a, float sa, float ca, float3 b, float
   float e = 2.0f * atan2(v, ((1.0f + cd) + ca) + cb);
   float lens = 2.0f * (phi_a * omc_a + phi_b * omc_b - e);
   return clamp(lens, 0.0f, fmin(area_a, area_b));
+}
+
+// Any two caps: a cap larger than a hemisphere is replaced by its complement (the cap of axis -a
+// and cos -cos r), so the lens formula only meets caps up to a hemisphere, where its terms are
+// at most ~2 pi; a nearly-whole-sphere cap would otherwise cancel terms of 4 pi into a small
+// result. |A n B| = |A| - |A n B^c|, and with both complemented
+// |A n B| = 4 pi - |A^c| - |B^c| + |A^c n B^c| = -2 pi (cos ra + cos rb) + |A^c n B^c|.
+INLINE float cap_intersection_area(float3 a, float sa, float ca, float3 b, float sb, float cb) {
+  if (ca < 0.0f && cb < 0.0f)
+    return fmax(-2.0f * CANOPY_PI * (ca + cb) + cap_lens_area(-a, sa, -ca, -b, sb, -cb), 0.0f);
+  if (cb < 0.0f) return fmax(cap_solid_angle(sa, ca) - cap_lens_area(a, sa, ca, -b, sb, -cb), 0.0f);
+  if (ca < 0.0f) return fmax(cap_solid_angle(sb, cb) - cap_lens_area(-a, sa, -ca, b, sb, cb), 0.0f);
+  return cap_lens_area(a, sa, ca, b, sb, cb);
 }
 
 // Image of the cap {w : w.a >= cos r} under the pivot transform about xi (|xi| < 1, m = 1 -
