@@ -108,14 +108,46 @@ double albedo(V3 wo, double a, double* cos_eff) {
   return sum / (double(n) * n);
 }
 
-// Solid angle of the pivot image of the upper hemisphere (cap_pivot with a = z, cos r = 0).
-double horizon_image_area(V3 xi, double m) {
-  V3 nv = xi * (-2.0 * xi.z) - V3{0, 0, m};
-  double len = std::sqrt(dot(nv, nv));
-  double c = -2.0 * xi.z / len, s = m / len;
-  double omc = c > 0.0 ? s * s / (1.0 + c) : 1.0 - c;
-  return 2.0 * kPi * omc;
+// Cap machinery of cl/bsdf/cap_integral.h in double (see the comments there).
+V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double omc(double s, double c) { return c > 0.0 ? s * s / (1.0 + c) : 1.0 - c; }
+double lens_area(V3 a, double sa, double ca, V3 b, double sb, double cb) {
+  double cd = std::fmin(std::fmax(dot(a, b), -1.0), 1.0);
+  V3 x3 = cross(a, b);
+  double sd = std::sqrt(dot(x3, x3));
+  double ra = std::atan2(sa, ca), rb = std::atan2(sb, cb), d = std::atan2(sd, cd);
+  double oa = omc(sa, ca), ob = omc(sb, cb);
+  if (d >= ra + rb) return 0.0;
+  if (d + ra <= rb) return 2.0 * kPi * oa;
+  if (d + rb <= ra) return 2.0 * kPi * ob;
+  double x = (cb - cd) + cd * oa, y = (ca - cd) + cd * ob, h = sa * sd;
+  double v = std::sqrt(std::fmax(0.0, (h - x) * (h + x)));
+  double e = 2.0 * std::atan2(v, 1.0 + cd + ca + cb);
+  double lens = 2.0 * (std::atan2(v, x) * oa + std::atan2(v, y) * ob - e);
+  return std::fmin(std::fmax(lens, 0.0), 2.0 * kPi * std::fmin(oa, ob));
 }
+double intersection_area(V3 a, double sa, double ca, V3 b, double sb, double cb) {
+  V3 na = a * -1.0, nb = b * -1.0;
+  if (ca < 0.0 && cb < 0.0) return std::fmax(-2.0 * kPi * (ca + cb) + lens_area(na, sa, -ca, nb, sb, -cb), 0.0);
+  if (cb < 0.0) return std::fmax(2.0 * kPi * omc(sa, ca) - lens_area(a, sa, ca, nb, sb, -cb), 0.0);
+  if (ca < 0.0) return std::fmax(2.0 * kPi * omc(sb, cb) - lens_area(na, sa, -ca, b, sb, cb), 0.0);
+  return lens_area(a, sa, ca, b, sb, cb);
+}
+V3 pivot_cap(V3 xi, double m, V3 a, double s, double c, double* so, double* co) {
+  double xa = dot(xi, a), delta = c - xa;
+  V3 nv = xi * (2.0 * delta) - a * m;
+  double e = delta * (2.0 - m) - m * xa, len = std::sqrt(dot(nv, nv));
+  *so = m * s / len;
+  *co = e / len;
+  return nv * (1.0 / len);
+}
+
+struct TestCap {
+  V3 c;
+  double s, co; // sin, cos of the half-angle
+  double ref;   // the lobe's integral over it (from the fit's directions)
+  double inv_w; // 1 / the error weight
+};
 
 struct Sample {
   V3 w;
@@ -132,6 +164,7 @@ struct Model {
   V3 wo;
   double alpha, rho;
   const std::vector<Sample>* samples;
+  const std::vector<TestCap>* caps;
   bool pivot(const double* p, V3* xi, double* m) const {
     double gap = std::exp(p[0]) * alpha;
     if (!(gap > 1e-7 && gap <= 1.0)) return false;
@@ -139,18 +172,22 @@ struct Model {
     *m = gap * (2.0 - gap);
     return true;
   }
+  // Squared errors of the model's cap integrals against the lobe's, each relative to the
+  // integral plus 10% of the albedo: relative for the caps holding most of the lobe (what
+  // ranks the lights that matter), absolute for the tails.
   double error(const double* p) const {
     V3 xi;
     double m;
     if (!pivot(p, &xi, &m)) return 1e300;
-    double amp = rho / horizon_image_area(xi, m);
+    double hs, hc;
+    V3 ha = pivot_cap(xi, m, V3{0, 0, 1}, 1.0, 0.0, &hs, &hc);
+    double amp = rho / (2.0 * kPi * omc(hs, hc));
     double e = 0.0;
-    for (const Sample& s : *samples) {
-      V3 d = s.w - xi;
-      double lam = m / dot(d, d);
-      double g = amp * lam * lam;
-      double r = g - s.target;
-      e += s.weight * r * r;
+    for (const TestCap& c : *caps) {
+      double ps, pc;
+      V3 pa = pivot_cap(xi, m, c.c, c.s, c.co, &ps, &pc);
+      double r = (amp * intersection_area(pa, ps, pc, ha, hs, hc) - c.ref) * c.inv_w;
+      e += r * r;
     }
     return e;
   }
@@ -217,7 +254,7 @@ void nelder_mead(const Model& model, double* p, const double* step, int iters) {
 Cell fit_cell(double theta, double alpha, double* p) {
   V3 wo = {std::sin(theta), 0.0, std::cos(theta)};
   double cos_eff;
-  Model model{wo, alpha, albedo(wo, alpha, &cos_eff), nullptr};
+  Model model{wo, alpha, albedo(wo, alpha, &cos_eff), nullptr, nullptr};
   // The fit's directions: n x n visible-normal reflections and n x n cosine-distributed
   // directions, each weighted by the balance heuristic 1 / (N p_vndf + N p_cos).
   const int n = 48;
@@ -237,6 +274,32 @@ Cell fit_cell(double theta, double alpha, double* p) {
       add({r * std::cos(phi), r * std::sin(phi), std::sqrt(std::fmax(0.0, 1.0 - u1))});
     }
   model.samples = &samples;
+  // Test caps: centred on the mirror direction, the normal, the fit's visible-normal directions
+  // (a 4 x 4 subset) and cosine directions (4 x 4); half-angles 0.5, 1, 2 and 4 lobe widths
+  // (2 alpha) and 0.1, 0.3, 0.6, 1.0, 1.5 rad.
+  std::vector<V3> centres = {{-wo.x, -wo.y, wo.z}, {0, 0, 1}};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      double u1 = (i + 0.5) / 4, u2 = (j + 0.5) / 4;
+      V3 w = reflect(wo, sample_vndf(wo, alpha, u1, u2));
+      if (w.z > 0.0) centres.push_back(w);
+      double r = std::sqrt(u1), phi = 2.0 * kPi * u2 + 0.3;
+      centres.push_back({r * std::cos(phi), r * std::sin(phi), std::sqrt(std::fmax(0.0, 1.0 - u1))});
+    }
+  std::vector<double> radii = {0.1, 0.3, 0.6, 1.0, 1.5};
+  for (double k : {0.5, 1.0, 2.0, 4.0})
+    if (2.0 * alpha * k < 0.08) radii.push_back(2.0 * alpha * k);
+  std::vector<TestCap> caps;
+  for (V3 c : centres)
+    for (double r : radii) {
+      TestCap t{c, std::sin(r), std::cos(r), 0.0, 0.0};
+      double o = omc(t.s, t.co);
+      for (const Sample& smp : samples)
+        if (1.0 - dot(smp.w, c) <= o) t.ref += smp.weight * smp.target;
+      t.inv_w = 1.0 / (t.ref + 0.1 * model.rho);
+      caps.push_back(t);
+    }
+  model.caps = &caps;
   const double step[2] = {0.3, 0.05};
   nelder_mead(model, p, step, 300);
   nelder_mead(model, p, step, 300); // a restart: Nelder-Mead can stall on a collapsed simplex

@@ -11,8 +11,7 @@
 //   D_xi the uniform distribution pivoted about xi. The integral of D_xi over a region is the
 //   solid angle of its pivot image / 4 pi, and the pivot maps caps to caps, so the integral over
 //   C clipped by the horizon H is |P(C) n P(H)| / 4 pi: the intersection of two caps, in closed
-//   form. Fresnel is applied outside the fit, as one factor per lobe: the exact Fresnel (mean
-//   over RGB) at the lobe's effective cosine, tabulated with the fit.
+//   form. Fresnel is applied outside the fit, per cap (see CapLobe).
 // Delta lobes (alpha == 0) are excluded, as bsdf_eval excludes them.
 #ifndef CANOPY_CL_BSDF_CAP_INTEGRAL_H
 #define CANOPY_CL_BSDF_CAP_INTEGRAL_H
@@ -29,16 +28,24 @@
 #endif
 
 // Per shading point. float4s so the layout is the same 64 bytes in OpenCL C (float3 is 16 bytes
-// there) and C++.
+// there) and C++. The glossy part of S for a cap C is
+//   S_g = |P(C) n P(H)| ((1 - frac) (fres_normal + fres_grazing (1 - cos_h)^5) + frac fres_lobe)
+// with frac = |P(C) n P(H)| / |P(H)| the share of the lobe inside C and cos_h = wo.h for the half
+// vector towards the cap's centre: Schlick's Fresnel at that half vector for a small cap, the
+// lobe's mean Fresnel for a cap holding all of it (cap_lobe_make).
 typedef struct CapLobe {
-  float4 n;     // xyz: shading normal; w: diffuse scale, mean(albedo) / pi (0: no diffuse lobe)
-  float4 xi;    // xyz: SPTD pivot (|xi| < 1); w: 1 - |xi|^2, kept exact for sharp lobes
-  float4 horiz; // xyz: axis of the pivot image P(H) of the upper hemisphere; w: its cos
-  float horiz_sin;
-  float spec; // glossy scale: S_glossy = spec |P(C) n P(H)| (0: no glossy lobe)
-  int glossy; // conductor or plastic with alpha > 0
+  float4 n;  // xyz: shading normal; w: diffuse scale, mean(albedo) / pi (0: no diffuse lobe)
+  float4 xi; // xyz: SPTD pivot (|xi| < 1); w: 1 - |xi|^2, kept exact for sharp lobes
+  float4 wo; // xyz: direction to the viewer; w: fres_normal (amplitude x F(1))
+  float fres_grazing; // amplitude x (1 - F(1))
+  float fres_lobe;    // amplitude x the lobe's mean Fresnel
+  int glossy;         // conductor or plastic with alpha > 0
   int pad;
 } CapLobe;
+
+INLINE float cap_mean3(float3 v) {
+  return (v.x + v.y + v.z) * (1.0f / 3.0f);
+}
 
 // 1 - cos r of an angle given as (sin r, cos r), without cancellation near r = 0.
 INLINE float cap_one_minus_cos(float s, float c) {
@@ -206,9 +213,9 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
   float cos_o = dot(wo, n);
   l.n = f4_from3(n, 0.0f);
   l.xi = make_float4(0.0f, 0.0f, 0.0f, 1.0f);
-  l.horiz = f4_from3(-n, 0.0f); // P(H) for xi = 0 (the antipodal map): the lower hemisphere
-  l.horiz_sin = 1.0f;
-  l.spec = 0.0f;
+  l.wo = f4_from3(wo, 0.0f);
+  l.fres_grazing = 0.0f;
+  l.fres_lobe = 0.0f;
   l.glossy = 0;
   l.pad = 0;
   if (!(cos_o > 0.0f)) return l; // bsdf_eval is 0 for a viewer below the horizon
@@ -220,16 +227,6 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
   if (l.glossy) {
     float gap_a, angle, albedo, cos_f;
     cap_sptd_lookup(cos_o, m->alpha, &gap_a, &angle, &albedo, &cos_f);
-    // Fresnel (mean over RGB) at the lobe's effective cosine (sptd_table.h): the half vectors
-    // of a rough lobe seen at grazing angles are far from the normal, so F(cos theta_o) would
-    // overestimate it.
-    float3 fres;
-    if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) {
-      fres = fresnel_conductor(cos_f, xyz_of(m->specular), xyz_of(m->k));
-    } else {
-      fres = xyz_of(m->specular) * fresnel_dielectric(cos_f, m->ior);
-    }
-    float spec_scale = fmax((fres.x + fres.y + fres.z) * (1.0f / 3.0f), 0.0f);
     float gap = clamp(gap_a * fmax(m->alpha, SPTD_ALPHA_MIN), 1e-7f, 1.0f); // 1 - |xi|
     float norm = 1.0f - gap;
     // The tangent towards wo; any tangent at normal incidence (the lobe is symmetric there).
@@ -240,18 +237,30 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
     float mm = gap * (2.0f - gap);
     l.xi = f4_from3(xi, mm);
     float hs, hc;
-    float3 ha = cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
-    l.horiz = f4_from3(ha, hc);
-    l.horiz_sin = hs;
+    cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
     // amplitude = albedo / (|P(H)| / 4 pi) and S = amplitude |P(C) n P(H)| / 4 pi.
     float ph = cap_solid_angle(hs, hc);
-    l.spec = ph > 0.0f ? spec_scale * albedo / ph : 0.0f;
+    float amp = ph > 0.0f ? albedo / ph : 0.0f;
+    // Fresnel, mean over RGB: exact at normal incidence and at the lobe's effective cosine
+    // (sptd_table.h; the half vectors of a rough lobe seen at grazing angles are far from the
+    // normal, so F(cos theta_o) would overestimate it), Schlick's form between.
+    float f_normal, f_lobe, scale;
+    if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) {
+      float3 eta = xyz_of(m->specular), k = xyz_of(m->k);
+      f_normal = cap_mean3(fresnel_conductor(1.0f, eta, k));
+      f_lobe = cap_mean3(fresnel_conductor(cos_f, eta, k));
+      scale = 1.0f;
+    } else {
+      f_normal = fresnel_dielectric(1.0f, m->ior);
+      f_lobe = fresnel_dielectric(cos_f, m->ior);
+      scale = fmax(cap_mean3(xyz_of(m->specular)), 0.0f);
+    }
+    l.wo.w = amp * scale * f_normal;
+    l.fres_grazing = amp * scale * (1.0f - f_normal);
+    l.fres_lobe = amp * scale * f_lobe;
   }
 #endif
-  if (diffuse_base) {
-    float3 alb = xyz_of(m->albedo);
-    l.n.w = fmax((alb.x + alb.y + alb.z) * (1.0f / 3.0f), 0.0f) * CANOPY_INV_PI;
-  }
+  if (diffuse_base) l.n.w = fmax(cap_mean3(xyz_of(m->albedo)), 0.0f) * CANOPY_INV_PI;
   return l;
 }
 
@@ -265,11 +274,12 @@ INLINE int cap_lobe_is_glossy(const CapLobe* l) {
 
 INLINE float cap_lobe_integral(const CapLobe* l, float3 c, float sin_u, float cos_u, float* mean) {
   float3 n = xyz_of(l->n);
-  float diff = l->n.w, spec = l->spec;
+  float diff = l->n.w;
+  int glossy = l->fres_lobe > 0.0f || l->fres_grazing > 0.0f;
   float cos_w = dot(c, n);
   // The cap reaches above the horizon iff angle(c, n) < pi/2 + u.
   int above = cos_u < 0.0f || cos_w > -sin_u;
-  if (!above || !(diff > 0.0f || spec > 0.0f)) {
+  if (!above || !(diff > 0.0f || glossy)) {
     *mean = 0.0f;
     return 0.0f;
   }
@@ -281,26 +291,29 @@ INLINE float cap_lobe_integral(const CapLobe* l, float3 c, float sin_u, float co
     mean_point += diff * fmax(cos_w, 0.0f);
   }
 #if HAS_MICROFACET
-  if (spec > 0.0f) {
+  if (glossy) {
     float3 xi = xyz_of(l->xi);
     float mm = l->xi.w;
-    float ps, pc;
+    float hs, hc, ps, pc;
+    float3 ha = cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
     float3 pa = cap_pivot(xi, mm, c, sin_u, cos_u, &ps, &pc);
-    s += spec * cap_intersection_area(pa, ps, pc, xyz_of(l->horiz), l->horiz_sin, l->horiz.w);
+    float area = cap_intersection_area(pa, ps, pc, ha, hs, hc);
+    float frac = clamp(area / fmax(cap_solid_angle(hs, hc), 1e-30f), 0.0f, 1.0f);
+    // Schlick's weight at the half vector of wo and c: wo.h = cos(angle(wo, c) / 2).
+    float cos_h = sqrt(fmax(0.0f, 0.5f + 0.5f * dot(xyz_of(l->wo), c)));
+    float x = 1.0f - cos_h, x2 = x * x;
+    float f_point = l->wo.w + l->fres_grazing * (x2 * x2 * x);
+    float fres = f_point + frac * (l->fres_lobe - f_point);
+    s += area * fres;
     if (cos_w > 0.0f) {
       float3 dv = c - xi;
       float lam = mm / fmax(dot(dv, dv), 1e-30f); // the pivot's local area scale at c
-      mean_point += spec * lam * lam;             // |P(C)| -> lam^2 |C|
+      mean_point += f_point * lam * lam;          // |P(C)| -> lam^2 |C|
     }
   }
 #endif
   float omega = cap_solid_angle(sin_u, cos_u);
-  float mu;
-  if (omega > 1e-30f) {
-    mu = s / omega;
-  } else {
-    mu = mean_point;
-  }
+  float mu = omega > 1e-30f ? s / omega : mean_point;
   *mean = fmax(mu, CAP_INTEGRAL_FLOOR);
   return fmax(s, CAP_INTEGRAL_FLOOR);
 }
