@@ -443,26 +443,23 @@ std::vector<std::pair<D3, double>> test_caps(float3 wo, double alpha, std::mt199
 TEST(CapIntegral, GlossyMatchesReference) {
   std::mt19937 rng(2019);
   std::vector<Material> mats;
-  std::vector<std::string> names;
   for (double rough : {0.05, 0.1, 0.2, 0.4, 0.7, 1.0}) {
     float alpha = float(rough * rough);
-    for (const Metal& mt : kMetals) {
+    for (const Metal& mt : kMetals)
       mats.push_back(conductor_mat(mt.eta, mt.k, alpha));
-      names.push_back(std::string(mt.name) + " r" + std::to_string(rough));
-    }
     mats.push_back(plastic_mat(alpha));
-    names.push_back("plastic r" + std::to_string(rough));
   }
-  std::vector<double> abs_all, rel_big;
-  const int n = 2048;
-  for (size_t mi = 0; mi < mats.size(); ++mi) {
-    const Material& m = mats[mi];
+  // Errors for theta_o <= 60 degrees and for 75, 85 degrees (where the GGX lobe is anisotropic
+  // and the SPTD, isotropic about its peak, fits it least well).
+  std::vector<double> abs_err[2], rel_big[2];
+  const int n = 1024;
+  for (const Material& m : mats) {
     for (double theta_deg : {0.0, 30.0, 60.0, 75.0, 85.0}) {
+      int g = theta_deg > 60.0;
       double th = theta_deg * kPi / 180;
       float3 wo = make_float3(float(std::sin(th)), 0.0f, float(std::cos(th)));
       // A random world frame: the API works in world space.
-      D3 nw = random_unit(rng);
-      Frame fr = frame_from(f3(nw));
+      Frame fr = frame_from(f3(random_unit(rng)));
       CapLobe lobe = cap_lobe_make(&m, &fr, frame_to_world(&fr, wo));
       double albedo = reference_integral(m, wo, {0, 0, 1}, kPi, 8 * n);
       for (auto [c, r] : test_caps(wo, m.alpha, rng)) {
@@ -470,21 +467,32 @@ TEST(CapIntegral, GlossyMatchesReference) {
         float mean;
         float got = cap_lobe_integral(&lobe, frame_to_world(&fr, f3(c)), float(std::sin(r)),
                                       float(std::cos(r)), &mean);
-        double err = std::fabs(got - ref) / albedo;
-        if (getenv("CAP_DIAG") && (err > 0.1 || (ref > 0.1 * albedo && std::fabs(got - ref) > 0.25 * ref)))
-          std::printf("DIAG %s th %.0f c (%.3f %.3f %.3f) r %.4f got %.5f ref %.5f alb %.4f\n",
-                      names[mi].c_str(), theta_deg, c.x, c.y, c.z, r, got, ref, albedo);
-        abs_all.push_back(err);
-        if (ref > 0.1 * albedo) rel_big.push_back(std::fabs(got - ref) / ref);
+        abs_err[g].push_back(std::fabs(got - ref) / albedo);
+        if (ref > 0.1 * albedo) rel_big[g].push_back(std::fabs(got - ref) / ref);
+        if (getenv("CAP_DIAG") && ref > 0.1 * albedo && std::fabs(got - ref) > 0.1 * ref)
+          std::printf("DIAG type %d alpha %.4f th %.0f c (%.3f %.3f %.3f) r %.4f got %.5f ref "
+                      "%.5f alb %.4f\n",
+                      m.type, m.alpha, theta_deg, c.x, c.y, c.z, r, got, ref, albedo);
       }
     }
   }
-  double p50, p90, p99, mx;
-  std::printf("glossy (conductors and plastic, roughness 0.05..1, theta_o 0..85 deg):\n");
-  percentiles(abs_all, "|S - S_ref| / albedo, all caps", &p50, &p90, &p99, &mx);
-  EXPECT_LT(p50, 1.0);
-  percentiles(rel_big, "|S - S_ref| / S_ref, S_ref > 10%", &p50, &p90, &p99, &mx);
-  EXPECT_LT(p50, 1.0);
+  // Bounds: the figures docs/cap-integral.md quotes (measured with the committed table), with
+  // headroom of ~1.5x for a refit; a change that breaks the fit or the geometry moves them by
+  // far more.
+  const char* group[2] = {"theta_o 0..60", "theta_o 75, 85"};
+  const double bound_abs[2][4] = {{0.001, 0.015, 0.06, 0.25}, {0.002, 0.05, 0.15, 0.4}};
+  const double bound_rel[2][4] = {{0.005, 0.04, 0.3, 1.0}, {0.02, 0.15, 0.8, 1.2}};
+  for (int g = 0; g < 2; ++g) {
+    double q[4];
+    std::printf("glossy (gold, copper, aluminium, plastic; roughness 0.05..1; %s deg):\n",
+                group[g]);
+    percentiles(abs_err[g], "|S - S_ref| / albedo, all caps", &q[0], &q[1], &q[2], &q[3]);
+    for (int k = 0; k < 4; ++k)
+      EXPECT_LT(q[k], bound_abs[g][k]) << group[g] << " abs quantile " << k;
+    percentiles(rel_big[g], "|S - S_ref| / S_ref, S_ref > 10%", &q[0], &q[1], &q[2], &q[3]);
+    for (int k = 0; k < 4; ++k)
+      EXPECT_LT(q[k], bound_rel[g][k]) << group[g] << " rel quantile " << k;
+  }
 }
 
 // The diffuse lobe through the API (world frame, mean over RGB): albedo / pi times the clipped
@@ -574,4 +582,66 @@ TEST(CapIntegral, SmallCapLimit) {
   double p50, p90, p99, mx;
   std::printf("small-cap limit (u = 1e-6), directions drawn from the lobe:\n");
   percentiles(rel, "|mean - f cos| / f cos", &p50, &p90, &p99, &mx);
+  // The limit is the exact GGX f cos times the per-cap Fresnel: exact for the plastic coat,
+  // Lazanyi's approximation for the conductors (within 2.3% of the exact mean-RGB Fresnel for
+  // these metals over cos in [0.02, 1]), plus float rounding.
+  EXPECT_LT(mx, 0.03);
+}
+
+// Positivity (the light sampler's unbiasedness): S > 0 and mean > 0 wherever the cap reaches
+// above the horizon and the material reflects, exactly 0 where it lies entirely below; finite
+// everywhere, including grazing viewers (wo.z down to 1e-3), alpha from 1e-4 to 1, caps from
+// 1e-6 rad to the whole sphere.
+TEST(CapIntegral, PositiveAboveHorizonZeroBelowFinite) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int above = 0, below = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Material m;
+    float alpha = float(std::exp(std::log(1e-4) * u(rng)));
+    int type = i % 3;
+    if (type == 0)
+      m = diffuse_mat(0.5f, 0.2f, 0.1f);
+    else if (type == 1)
+      m = conductor_mat(kMetals[i % 3].eta, kMetals[i % 3].k, alpha);
+    else
+      m = plastic_mat(alpha);
+    D3 nw = random_unit(rng);
+    Frame fr = frame_from(f3(nw));
+    double zo = i % 4 == 0 ? 1e-3 : u(rng), phi = 2 * kPi * u(rng);
+    double so = std::sqrt(1 - zo * zo);
+    float3 wo = frame_to_world(
+        &fr, make_float3(float(so * std::cos(phi)), float(so * std::sin(phi)), float(zo)));
+    CapLobe l = cap_lobe_make(&m, &fr, wo);
+    // Log-uniform in [1e-6, pi], the whole sphere and the smallest cap.
+    double r =
+        i % 5 == 0 ? kPi : std::exp(std::log(1e-6) + (std::log(kPi) - std::log(1e-6)) * u(rng));
+    if (i % 7 == 0) r = 1e-6;
+    // Centres: random, and near the horizon within a few cap radii.
+    D3 cl = random_unit(rng);
+    if (i % 2 == 1) {
+      double e = std::clamp((2 * u(rng) - 1) * 3 * r, -kPi / 2, kPi / 2), ph = 2 * kPi * u(rng);
+      cl = {std::cos(e) * std::cos(ph), std::cos(e) * std::sin(ph), std::sin(e)};
+    }
+    float3 c = normalize(frame_to_world(&fr, f3(cl)));
+    float su = float(std::sin(r)), cu = float(std::cos(r));
+    if (r == kPi) su = 0.0f, cu = -1.0f;
+    float mean = -1;
+    float s = cap_lobe_integral(&l, c, su, cu, &mean);
+    ASSERT_TRUE(std::isfinite(s) && std::isfinite(mean)) << i;
+    // The float centre's own angle to the normal decides (as the function sees it).
+    float cw = dot(c, fr.n);
+    bool reaches = cu < 0 || cw > -su;
+    if (reaches) {
+      EXPECT_GT(s, 0.0f) << i << " r " << r << " cos_w " << cw;
+      EXPECT_GT(mean, 0.0f) << i;
+      ++above;
+    } else {
+      EXPECT_EQ(s, 0.0f) << i;
+      EXPECT_EQ(mean, 0.0f) << i;
+      ++below;
+    }
+  }
+  EXPECT_GT(above, 5000);
+  EXPECT_GT(below, 2000);
 }

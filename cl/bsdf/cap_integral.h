@@ -131,26 +131,25 @@ INLINE float cap_cosine_integral(float cos_w, float sin_w, float sin_r, float co
 INLINE float cap_lens_area(float3 a, float sa, float ca, float3 b, float sb, float cb) {
   float cd = clamp(dot(a, b), -1.0f, 1.0f);
   float sd = length(cross(a, b));
-  float ra = atan2(sa, ca), rb = atan2(sb, cb), d = atan2(sd, cd);
-  float area_a = cap_solid_angle(sa, ca), area_b = cap_solid_angle(sb, cb);
-  if (d >= ra + rb) return 0.0f;
-  if (d + ra <= rb) return area_a;
-  if (d + rb <= ra) return area_b;
   float omc_a = cap_one_minus_cos(sa, ca), omc_b = cap_one_minus_cos(sb, cb);
+  float area_a = 2.0f * CANOPY_PI * omc_a, area_b = 2.0f * CANOPY_PI * omc_b;
   float x = (cb - cd) + cd * omc_a; // cos rb - cos d cos ra
   float y = (ca - cd) + cd * omc_b; // cos ra - cos d cos rb
   float h = sa * sd;
   float v = sqrt(fmax(0.0f, (h - x) * (h + x)));
-  float phi_a = atan2(v, x), phi_b = atan2(v, y);
-  if (fmin(ra, rb) < 1e-3f) {
+  // The circles do not cross (V = 0): x <= 0 puts A's whole circle inside B (A in B, or equal
+  // caps), y <= 0 B's inside A, else disjoint (no angles needed: caps are at most hemispheres).
+  if (!(v > 0.0f)) return x <= 0.0f ? area_a : (y <= 0.0f ? area_b : 0.0f);
+  if (fmin(sa, sb) < 1e-3f) {
     // The segment of the small cap on the other cap's side of the chord: (phi - sin phi cos phi)
-    // / pi of its area (phi its half-angle at the centre, which atan2 gives for either cap).
-    int a_small = ra <= rb;
-    float phi = a_small ? phi_a : phi_b;
+    // / pi of its area (phi its half-angle at the centre).
+    int a_small = sa <= sb;
     float c = a_small ? x : y;
+    float phi = atan2(v, c);
     float sc = v * c / fmax(v * v + c * c, 1e-37f);
     return (a_small ? area_a : area_b) * fmax(phi - sc, 0.0f) * CANOPY_INV_PI;
   }
+  float phi_a = atan2(v, x), phi_b = atan2(v, y);
   float e = 2.0f * atan2(v, ((1.0f + cd) + ca) + cb);
   float lens = 2.0f * (phi_a * omc_a + phi_b * omc_b - e);
   return clamp(lens, 0.0f, fmin(area_a, area_b));
@@ -324,38 +323,48 @@ INLINE float cap_lobe_integral(const CapLobe* l, float3 c, float sin_u, float co
 #if HAS_MICROFACET
   if (spec > 0.0f) {
     float3 xi = xyz_of(l->xi), wo = xyz_of(l->wo);
-    float mm = cap_pivot_m(xi), alpha = fabs(l->wo.w);
-    float hs, hc, ps, pc;
-    float3 ha = cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
-    float3 pa = cap_pivot(xi, mm, c, sin_u, cos_u, &ps, &pc);
-    float area = cap_intersection_area(pa, ps, pc, ha, hs, hc);
-    float frac = clamp(area / fmax(cap_solid_angle(hs, hc), 1e-30f), 0.0f, 1.0f);
+    float alpha = fabs(l->wo.w);
     // Fresnel at the half vector of wo and c: wo.h = cos(angle(wo, c) / 2) = |wo + c| / 2.
     float3 hv = wo + c;
     float hl2 = dot(hv, hv);
     float f_c = cap_fresnel(l, sqrt(fmax(0.0f, 0.25f * hl2)));
-    float s_sptd = l->amp * area * (f_c + frac * (l->xi.w - f_c));
-    // The exact GGX f cos at the centre (microfacet.h, Fresnel as f_c): a cap much smaller than
-    // the lobe sees it as constant, where the fit's pointwise error (tens of percent in places)
-    // would dominate. Weight 1 / (1 + (u / alpha)^2): the point value below the lobe's width
-    // (~2 alpha), the SPTD integral above it.
-    float fc_exact = 0.0f;
-    float zo = dot(wo, n);
-    if (cos_w > 0.0f && hl2 > 0.0f) {
-      float3 h = hv * (1.0f / sqrt(hl2));
-      float3 ht = cross(h, n); // tangential part, exact near h = n
-      float a2 = alpha * alpha;
-      float sd = dot(ht, ht) / a2 + dot(h, n) * dot(h, n);
-      float d = 1.0f / ((CANOPY_PI * a2 * sd) * sd);
-      float3 ct = cross(c, n), ot = cross(wo, n);
-      float lo = sqrt(zo * zo + a2 * dot(ot, ot)), li = sqrt(cos_w * cos_w + a2 * dot(ct, ct));
-      float den = cos_w * lo + zo * li;
-      fc_exact = den > 0.0f ? f_c * d * cos_w / (2.0f * den) : 0.0f;
-    }
+    // A cap much smaller than the lobe sees it as constant: there the exact GGX f cos at the
+    // centre (microfacet.h, Fresnel f_c) times the solid angle is exact, where the fit's
+    // pointwise error (tens of percent in places) would dominate. The weight
+    // w = 1 / (1 + (u / (0.2 alpha))^4) keeps the point value below ~0.1 alpha (the lobe's
+    // width is ~2 alpha) and hands over to the SPTD integral by ~0.4 alpha. Each part is
+    // computed only where its weight is not negligible.
     float t = sin_u / (0.2f * alpha), t2 = t * t;
     float w = cos_u > 0.0f ? 1.0f / (1.0f + t2 * t2) : 0.0f;
-    s += s_sptd + w * (omega * fc_exact - s_sptd);
-    mean_point += fc_exact;
+    float s_g = 0.0f;
+    if (w > 1e-4f) {
+      float fc_exact = 0.0f;
+      float zo = dot(wo, n);
+      if (cos_w > 0.0f && hl2 > 0.0f) {
+        float3 h = hv * (1.0f / sqrt(hl2));
+        float3 ht = cross(h, n); // tangential part, exact near h = n
+        float a2 = alpha * alpha;
+        float hz = dot(h, n);
+        float sd = dot(ht, ht) / a2 + hz * hz;
+        float d = 1.0f / ((CANOPY_PI * a2 * sd) * sd);
+        float3 ct = cross(c, n), ot = cross(wo, n);
+        float lo = sqrt(zo * zo + a2 * dot(ot, ot)), li = sqrt(cos_w * cos_w + a2 * dot(ct, ct));
+        float den = cos_w * lo + zo * li;
+        fc_exact = den > 0.0f ? f_c * d * cos_w / (2.0f * den) : 0.0f;
+      }
+      s_g += w * omega * fc_exact;
+      mean_point += fc_exact;
+    }
+    if (w < 1.0f) {
+      float mm = cap_pivot_m(xi);
+      float hs, hc, ps, pc;
+      float3 ha = cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
+      float3 pa = cap_pivot(xi, mm, c, sin_u, cos_u, &ps, &pc);
+      float area = cap_intersection_area(pa, ps, pc, ha, hs, hc);
+      float frac = clamp(area / fmax(cap_solid_angle(hs, hc), 1e-30f), 0.0f, 1.0f);
+      s_g += (1.0f - w) * l->amp * area * (f_c + frac * (l->xi.w - f_c));
+    }
+    s += s_g;
   }
 #endif
   float mu = omega > 1e-30f ? s / omega : mean_point;
