@@ -469,10 +469,6 @@ TEST(CapIntegral, GlossyMatchesReference) {
                                       float(std::cos(r)), &mean);
         abs_err[g].push_back(std::fabs(got - ref) / albedo);
         if (ref > 0.1 * albedo) rel_big[g].push_back(std::fabs(got - ref) / ref);
-        if (getenv("CAP_DIAG") && ref > 0.1 * albedo && std::fabs(got - ref) > 0.1 * ref)
-          std::printf("DIAG type %d alpha %.4f th %.0f c (%.3f %.3f %.3f) r %.4f got %.5f ref "
-                      "%.5f alb %.4f\n",
-                      m.type, m.alpha, theta_deg, c.x, c.y, c.z, r, got, ref, albedo);
       }
     }
   }
@@ -572,9 +568,6 @@ TEST(CapIntegral, SmallCapLimit) {
           EXPECT_NEAR(mean6, mean3v, 1e-3 * mean6) << rough << " " << theta_deg;
           (void)mean_t;
           rel.push_back(std::fabs(mean6 - fc) / fc);
-          if (getenv("CAP_DIAG") && std::fabs(mean6 - fc) > 0.1 * fc)
-            std::printf("DIAG mt %d rough %.2f th %.0f c.z %.3f mean %g fc %g\n", mt, rough,
-                        theta_deg, c.z, mean6, fc);
         }
       }
     }
