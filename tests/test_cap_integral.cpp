@@ -294,14 +294,15 @@ TEST(CapIntegral, DiffuseMatchesQuadrature) {
     double bound = 1e-5 * ref + 1e-5 * scale;
     EXPECT_NEAR(got, ref, bound) << "w " << w << " r " << r;
     worst_abs = std::max(worst_abs, std::fabs(got - ref) / scale);
-    worst = std::max(worst, std::fabs(got - ref) / std::max(ref, 1e-30));
+    if (ref > 1e-3 * scale) worst = std::max(worst, std::fabs(got - ref) / ref);
   }
   EXPECT_GT(straddling, 500);
   // The whole sphere and the upper hemisphere: pi.
   EXPECT_NEAR(cap_cosine_integral(0.3f, std::sqrt(1 - 0.09f), 0.0f, -1.0f), kPi, 1e-6);
   EXPECT_NEAR(cap_cosine_integral(1.0f, 0.0f, 1.0f, 0.0f), kPi, 1e-6);
-  std::printf("diffuse: worst error %.3g relative to the terms' scale, %.3g relative\n", worst_abs,
-              worst);
+  std::printf(
+      "diffuse: worst error %.3g of the terms' scale, %.3g relative (results > 1e-3 of it)\n",
+      worst_abs, worst);
 }
 
 namespace {
@@ -576,7 +577,7 @@ TEST(CapIntegral, SmallCapLimit) {
   std::printf("small-cap limit (u = 1e-6), directions drawn from the lobe:\n");
   percentiles(rel, "|mean - f cos| / f cos", &p50, &p90, &p99, &mx);
   // The limit is the exact GGX f cos times the per-cap Fresnel: exact for the plastic coat,
-  // Lazanyi's approximation for the conductors (within 2.3% of the exact mean-RGB Fresnel for
+  // Lazanyi's approximation for the conductors (within 1.1% of the exact mean-RGB Fresnel for
   // these metals over cos in [0.02, 1]), plus float rounding.
   EXPECT_LT(mx, 0.03);
 }

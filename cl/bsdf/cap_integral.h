@@ -48,7 +48,7 @@ typedef struct CapLobe {
 // Plastic: fres0 x the exact dielectric Fresnel of index fres1 (cheap). Conductor: Schlick's
 // form with Lazanyi & Szirmay-Kalos's correction (2005, "Fresnel term approximations for
 // metals"), F(c) ~= F(1) + (1 - F(1)) (1 - c)^5 - a c (1 - c)^6 with fres0 = F(1) exact,
-// fres1 = 1 - F(1), fres2 = a fitted by least squares (within 2.5% of the exact mean for gold,
+// fres1 = 1 - F(1), fres2 = a fitted by least squares (within 1.1% of the exact mean for gold,
 // copper and aluminium, where three exact conductor Fresnels per cap would cost ~3x the rest).
 INLINE float cap_fresnel(const CapLobe* l, float c) {
   if (l->wo.w < 0.0f) return l->fres0 * fresnel_dielectric(c, l->fres1);
