@@ -355,7 +355,6 @@ double reference_integral(const Material& m, float3 wo, D3 c, double r, int n) {
   D3 t, b;
   basis(c, &t, &b);
   double o = omc(r), area = 2 * kPi * o;
-  double cos_r = std::cos(r);
   auto in_cap = [&](D3 w) { return 1.0 - ddot(w, c) <= o; };     // w.c >= cos r, for tiny r too
   const double g1 = 0.7548776662466927, g2 = 0.5698402909980532; // R2 (Roberts 2018)
   double sum = 0;
@@ -382,7 +381,6 @@ double reference_integral(const Material& m, float3 wo, D3 c, double r, int n) {
       }
     }
   }
-  (void)cos_r;
   return sum;
 }
 
@@ -561,13 +559,13 @@ TEST(CapIntegral, SmallCapLimit) {
           if (!(bs.pdf > 0) || bs.wi.z < 1e-3f) continue;
           float3 c = bs.wi;
           double fc = mean3(bsdf_eval(&m, wo, c)) * c.z;
-          float mean6, mean3v, mean_t;
+          float mean6, mean5;
           cap_lobe_integral(&l, c, 1e-6f, 1.0f, &mean6);
-          cap_lobe_integral(&l, c, 1e-5f, 1.0f, &mean3v);
-          // A cap of 1e-3 rad is far below every lobe width here (2 alpha >= 5e-3): the two
-          // means differ by the lobe's curvature over the cap, O((1e-3 / width)^2) < 5%.
-          EXPECT_NEAR(mean6, mean3v, 1e-3 * mean6) << rough << " " << theta_deg;
-          (void)mean_t;
+          cap_lobe_integral(&l, c, 1e-5f, 1.0f, &mean5);
+          // Caps of 1e-6 and 1e-5 rad are far below every lobe width here (2 alpha >= 5e-3): the
+          // lobe's curvature over them is < (1e-5 / 2.5e-3)^2 ~ 2e-5, so the means agree to
+          // float rounding unless a 1 - cos cancellation in the cap's solid angle (or S) shows.
+          EXPECT_NEAR(mean6, mean5, 1e-3 * mean6) << rough << " " << theta_deg;
           rel.push_back(std::fabs(mean6 - fc) / fc);
         }
       }

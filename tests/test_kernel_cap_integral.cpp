@@ -1,8 +1,8 @@
 // cl/bsdf/cap_integral.h compiled as OpenCL C on PoCL against the host (C++) build of the same
 // header: a probe kernel runs cap_lobe_make, cap_lobe_integral and cap_lobe_is_glossy for every
 // material type and a spread of caps (tiny to the whole sphere, straddling the horizon), with
-// every feature on and with a diffuse-only feature set (no GGX code, so the SPTD table is not
-// even included). The accuracy tests are host-side (test_cap_integral.cpp).
+// every feature on and with each material feature alone (diffuse-only: no GGX code, so the SPTD
+// table is not even included). The accuracy tests are host-side (test_cap_integral.cpp).
 //
 // Tolerance: the device's sqrt, sin, cos, acos and atan2 may differ from glibc's by an ulp or
 // two; a few ulps in the pivot's position move a sharp lobe's (alpha = 0.01) cap integrals by up
@@ -156,10 +156,18 @@ TEST(KernelCapIntegral, MatchesHost) {
   run(rt, "", mats, 1);
 }
 
-TEST(KernelCapIntegral, DiffuseOnlyKernelMatchesHost) {
-  ClRuntime rt;
+std::string features(bool conductor_on, bool plastic_on) {
   KernelFeatures f;
-  f.material_conductor = false;
-  f.material_plastic = false;
-  run(rt, f.build_options(), {diffuse()}, 2);
+  f.material_conductor = conductor_on;
+  f.material_plastic = plastic_on;
+  return f.build_options();
+}
+
+// Each material feature alone (the host, compiled with everything on, computes the same values:
+// a feature only removes code for types the scene does not have).
+TEST(KernelCapIntegral, SpecialisedKernelsMatchHost) {
+  ClRuntime rt;
+  run(rt, features(false, false), {diffuse()}, 2); // diffuse only: no GGX code, no table
+  run(rt, features(true, false), {diffuse(), conductor(0.01f), conductor(0.5f)}, 3);
+  run(rt, features(false, true), {diffuse(), plastic(0.0f), plastic(0.09f)}, 4);
 }

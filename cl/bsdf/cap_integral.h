@@ -49,7 +49,7 @@ typedef struct CapLobe {
 // form with Lazanyi & Szirmay-Kalos's correction (2005, "Fresnel term approximations for
 // metals"), F(c) ~= F(1) + (1 - F(1)) (1 - c)^5 - a c (1 - c)^6 with fres0 = F(1) exact,
 // fres1 = 1 - F(1), fres2 = a fitted by least squares (within 1.1% of the exact mean for gold,
-// copper and aluminium, where three exact conductor Fresnels per cap would cost ~3x the rest).
+// copper and aluminium; the exact one costs three square roots and divisions per channel).
 INLINE float cap_fresnel(const CapLobe* l, float c) {
   if (l->wo.w < 0.0f) return l->fres0 * fresnel_dielectric(c, l->fres1);
   float x = 1.0f - c, x2 = x * x, x5 = x2 * x2 * x;
