@@ -236,13 +236,19 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
   l.fres1 = 0.0f;
   l.fres2 = 0.0f;
   l.amp = 0.0f;
-  if (!(cos_o > 0.0f)) return l; // bsdf_eval is 0 for a viewer below the horizon
   int diffuse_base = 1;
 #if HAS_MICROFACET
   int glossy_type = IS_MATERIAL(m, MATERIAL_CONDUCTOR) || IS_MATERIAL(m, MATERIAL_PLASTIC);
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) diffuse_base = 0;
-  if (glossy_type && !ggx_is_delta(m->alpha)) {
-    l.wo.w = ggx_alpha(m->alpha);
+  int glossy = glossy_type && !ggx_is_delta(m->alpha);
+  // The glossy flag (cap_lobe_is_glossy) describes the material, also for a viewer below the
+  // horizon, where the amplitudes stay 0.
+  if (glossy)
+    l.wo.w = IS_MATERIAL(m, MATERIAL_PLASTIC) ? -ggx_alpha(m->alpha) : ggx_alpha(m->alpha);
+#endif
+  if (!(cos_o > 0.0f)) return l; // bsdf_eval is 0 for a viewer below the horizon
+#if HAS_MICROFACET
+  if (glossy) {
     float gap_a, angle, albedo, cos_f;
     cap_sptd_lookup(cos_o, m->alpha, &gap_a, &angle, &albedo, &cos_f);
     float gap = clamp(gap_a * fmax(m->alpha, SPTD_ALPHA_MIN), 1e-7f, 1.0f); // 1 - |xi|
@@ -280,7 +286,6 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
       l.fres2 = num / den;
       f_lobe = cap_mean3(fresnel_conductor(cos_f, eta, k));
     } else {
-      l.wo.w = -l.wo.w;
       l.fres0 = fmax(cap_mean3(eta), 0.0f); // plastic: the specular tint
       l.fres1 = m->ior;
       f_lobe = l.fres0 * fresnel_dielectric(cos_f, m->ior);
