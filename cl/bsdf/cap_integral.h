@@ -29,11 +29,11 @@
 
 // Per shading point. float4s so the layout is the same 64 bytes in OpenCL C (float3 is 16 bytes
 // there) and C++. The glossy part of S for a cap C is
-//   S_sptd = amp |P(C) n P(H)| ((1 - frac) F_c + frac fres_lobe),
-// with frac = |P(C) n P(H)| / |P(H)| the share of the lobe inside C and F_c the Fresnel factor
-// at the half vector h_c of wo and the cap's centre (cap_fresnel): a small cap sees F(wo.h_c), a
-// cap holding the whole lobe its mean Fresnel. Caps small against the lobe blend in the exact
-// GGX f cos at the centre (cap_lobe_integral).
+//   S_sptd = amp |P(C) n P(H)| ((1 - frac) F_q + frac fres_lobe),
+// with frac = |P(C) n P(H)| / |P(H)| the share of the lobe inside C and F_q the Fresnel factor
+// (cap_fresnel) at the half vector of wo and the cap's point q nearest the lobe's peak, where the
+// lobe's mass inside the cap concentrates; a cap holding the whole lobe gets its mean Fresnel.
+// Caps small against the lobe blend in the exact GGX f cos at the centre (cap_lobe_integral).
 typedef struct CapLobe {
   float4 n;  // xyz: shading normal; w: diffuse scale, mean(albedo) / pi (0: no diffuse lobe)
   float4 xi; // xyz: SPTD pivot (|xi| < 1); w: fres_lobe, scale x the lobe's mean Fresnel
@@ -367,7 +367,20 @@ INLINE float cap_lobe_integral(const CapLobe* l, float3 c, float sin_u, float co
       float3 pa = cap_pivot(xi, mm, c, sin_u, cos_u, &ps, &pc);
       float area = cap_intersection_area(pa, ps, pc, ha, hs, hc);
       float frac = clamp(area / fmax(cap_solid_angle(hs, hc), 1e-30f), 0.0f, 1.0f);
-      s_g += (1.0f - w) * l->amp * area * (f_c + frac * (l->xi.w - f_c));
+      // Fresnel at the half vector towards the cap's point nearest the lobe's peak (the pivot's
+      // direction): where the lobe's mass inside the cap concentrates.
+      float xl = length(xi);
+      float3 pk = xl > 0.0f ? xi * (1.0f / xl) : n;
+      float cpc = dot(pk, c);
+      float3 q = pk;
+      if (cpc < cos_u) {
+        float3 tt = pk - c * cpc;
+        float tl = length(tt);
+        q = tl > 0.0f ? c * cos_u + tt * (sin_u / tl) : c;
+      }
+      float3 hq = wo + q;
+      float f_q = cap_fresnel(l, sqrt(fmax(0.0f, 0.25f * dot(hq, hq))));
+      s_g += (1.0f - w) * l->amp * area * (f_q + frac * (l->xi.w - f_q));
     }
     s += s_g;
   }
