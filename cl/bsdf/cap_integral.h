@@ -28,12 +28,10 @@
 #endif
 
 // Per shading point. float4s so the layout is the same 64 bytes in OpenCL C (float3 is 16 bytes
-// there) and C++. The glossy part of S for a cap C is
-//   S_sptd = amp |P(C) n P(H)| ((1 - frac) F_c + frac fres_lobe),
-// with frac = |P(C) n P(H)| / |P(H)| the share of the lobe inside C and F_c the Fresnel factor
-// at the half vector h_c of wo and the cap's centre (cap_fresnel): a small cap sees F(wo.h_c), a
-// cap holding the whole lobe its mean Fresnel. Caps small against the lobe blend in the exact
-// GGX f cos at the centre (cap_lobe_integral).
+// there) and C++. The glossy part of S for a cap C is the SPTD integral
+// amp |P(C) n P(H)| fres_lobe (the lobe's mean Fresnel), blended for caps small against the lobe
+// with the exact GGX f cos at the centre times |C| (Fresnel from cap_fresnel at its half vector;
+// cap_lobe_integral).
 typedef struct CapLobe {
   float4 n;  // xyz: shading normal; w: diffuse scale, mean(albedo) / pi (0: no diffuse lobe)
   float4 xi; // xyz: SPTD pivot (|xi| < 1); w: fres_lobe, scale x the lobe's mean Fresnel
@@ -329,15 +327,11 @@ INLINE float cap_lobe_integral(const CapLobe* l, float3 c, float sin_u, float co
   if (spec > 0.0f) {
     float3 xi = xyz_of(l->xi), wo = xyz_of(l->wo);
     float alpha = fabs(l->wo.w);
-    // Fresnel at the half vector of wo and c: wo.h = cos(angle(wo, c) / 2) = |wo + c| / 2.
-    float3 hv = wo + c;
-    float hl2 = dot(hv, hv);
-    float f_c = cap_fresnel(l, sqrt(fmax(0.0f, 0.25f * hl2)));
     // A cap much smaller than the lobe sees it as constant: there the exact GGX f cos at the
-    // centre (microfacet.h, Fresnel f_c) times the solid angle is exact, where the fit's
-    // pointwise error (tens of percent in places) would dominate. The weight
-    // w = 1 / (1 + (u / (0.2 alpha))^4) keeps the point value below ~0.1 alpha (the lobe's
-    // width is ~2 alpha) and hands over to the SPTD integral by ~0.4 alpha. Each part is
+    // centre (microfacet.h; Fresnel at the half vector of wo and c) times the solid angle is
+    // exact, where the fit's pointwise error (tens of percent in places) would dominate. The
+    // weight w = 1 / (1 + (u / (0.2 alpha))^4) keeps the point value below ~0.1 alpha (the
+    // lobe's width is ~2 alpha) and hands over to the SPTD integral by ~0.4 alpha. Each part is
     // computed only where its weight is not negligible.
     float t = sin_u / (0.2f * alpha), t2 = t * t;
     float w = cos_u > 0.0f ? 1.0f / (1.0f + t2 * t2) : 0.0f;
@@ -345,9 +339,13 @@ INLINE float cap_lobe_integral(const CapLobe* l, float3 c, float sin_u, float co
     if (w > 1e-4f) {
       float fc_exact = 0.0f;
       float zo = dot(wo, n);
+      float3 hv = wo + c;
+      float hl2 = dot(hv, hv);
       if (cos_w > 0.0f && hl2 > 0.0f) {
-        float3 h = hv * (1.0f / sqrt(hl2));
-        float3 ht = cross(h, n); // tangential part, exact near h = n
+        float hl = sqrt(hl2);
+        float3 h = hv * (1.0f / hl);
+        float f_c = cap_fresnel(l, 0.5f * hl); // wo.h = cos(angle(wo, c) / 2) = |wo + c| / 2
+        float3 ht = cross(h, n);               // tangential part, exact near h = n
         float a2 = alpha * alpha;
         float hz = dot(h, n);
         float sd = dot(ht, ht) / a2 + hz * hz;
@@ -361,13 +359,13 @@ INLINE float cap_lobe_integral(const CapLobe* l, float3 c, float sin_u, float co
       mean_point += fc_exact;
     }
     if (w < 1.0f) {
+      // The SPTD integral with the lobe's mean Fresnel (docs/cap-integral.md compares per-cap
+      // Fresnel factors: none did better, and they cost up to a quarter more).
       float mm = cap_pivot_m(xi);
       float hs, hc, ps, pc;
       float3 ha = cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
       float3 pa = cap_pivot(xi, mm, c, sin_u, cos_u, &ps, &pc);
-      float area = cap_intersection_area(pa, ps, pc, ha, hs, hc);
-      float frac = clamp(area / fmax(cap_solid_angle(hs, hc), 1e-30f), 0.0f, 1.0f);
-      s_g += (1.0f - w) * l->amp * area * (f_c + frac * (l->xi.w - f_c));
+      s_g += (1.0f - w) * l->amp * l->xi.w * cap_intersection_area(pa, ps, pc, ha, hs, hc);
     }
     s += s_g;
   }
