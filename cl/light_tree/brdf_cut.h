@@ -54,7 +54,9 @@ LT_HOT float4 lt_brdf_importance4(const LtLanes* l, float3 P, float3 Ng, const C
     if (!in[k] && !(ci >= cu || ci * cu + si * su > 0.0f)) continue;
     float mean;
     s[k] = cap_lobe_integral(lobe, c, su, cu, &mean);
-    if (!(s[k] > 0.0f) || !(mean > 0.0f)) {
+    // Culled by the mean S_C / Omega_C alone: a point light's cap has Omega_C = S_C = 0 but a
+    // positive mean (the BRDF towards it).
+    if (!(mean > 0.0f)) {
       s[k] = 0.0f;
       continue;
     }
@@ -92,8 +94,8 @@ INLINE int lt_code_splittable(int code) {
 // LT_BRDF_MAX_CUT entries. Clusters of importance 0 are left out (none of their lights can reach
 // P). Writes entries (code bits, importance) to cut[0..count) and returns count; *I_B = max S_C
 // over the cut (Eq. 8).
-INLINE int lt_brdf_cut_build(const LtTree* t, float3 P, float3 Ng, const CapLobe* lobe,
-                             float delta, GLOBAL float2* cut, float* I_B) {
+INLINE int lt_brdf_cut_build(const LtTree* t, float3 P, float3 Ng, const CapLobe* lobe, float delta,
+                             GLOBAL float2* cut, float* I_B) {
   int stack_code[LT_BRDF_MAX_CUT];
   float stack_imp[LT_BRDF_MAX_CUT], stack_s[LT_BRDF_MAX_CUT];
   int n = 0, top = 0;
