@@ -94,8 +94,8 @@ INLINE int lt_code_splittable(int code) {
 // LT_BRDF_MAX_CUT entries. Clusters of importance 0 are left out (none of their lights can reach
 // P). Writes entries (code bits, importance) to cut[0..count) and returns count; *I_B = max S_C
 // over the cut (Eq. 8).
-INLINE int lt_brdf_cut_build(const LtTree* t, float3 P, float3 Ng, const CapLobe* lobe, float delta,
-                             GLOBAL float2* cut, float* I_B) {
+INLINE int lt_brdf_cut_build(const LtTree* t, float3 P, float3 Ng, const CapLobe* lobe,
+                             float delta, GLOBAL float2* cut, float* I_B) {
   int stack_code[LT_BRDF_MAX_CUT];
   float stack_imp[LT_BRDF_MAX_CUT], stack_s[LT_BRDF_MAX_CUT];
   int n = 0, top = 0;
