@@ -12,6 +12,7 @@
 #include "accel/bvh.h"
 #include "integrator/brdf_mis.h"
 #include "integrator/light_pick.h"
+#include "integrator/shade_surface.h"
 #include "render/light_sampler_data.h"
 #include "scene/scene.h"
 
@@ -387,4 +388,46 @@ TEST_F(BrdfMisEstimator, UnbiasedForAreaLightsAgainstLightSampling) {
     }
   }
   std::printf("area lights: %d configurations, %.1f s\n", checked, elapsed(t0));
+}
+
+// A path whose ray escapes has no shading point: whatever its brdf_state held before (the
+// previous wave's path in the same slot, or a buffer never written: the renderer does not clear
+// it), the bounce's stages must do nothing for it. Stale state (cut of 3 clusters, N = 5, none
+// drawn yet) made brdf_sample draw from a cut that is not this path's.
+TEST_F(BrdfMisEstimator, EscapedPathDrawsNoBrdfSamplesWhateverItsStaleState) {
+  load(kAreaScene);
+  std::vector<Material> mats = materials_;
+  mats.push_back(conductor(0.3f));
+  SceneBuffers sc = scene_buffers();
+  sc.materials = mats.data();
+  for (const char* sampler : {"brdf-mis", "brdf-oriented"}) {
+    SCOPED_TRACE(sampler);
+    LightSamplerData data =
+        make_light_sampler_data(scene_.lights, sampler, LT_DEFAULT_SPLIT_THRESHOLD, 8, true);
+    std::vector<float2> cut(LT_BRDF_MAX_CUT, make_float2(uint_as_float_(0u), 1.0f));
+    LightSamplerCtx ls = data.host_view(scene_.lights, cut.data());
+    Paths p;
+#define PATH_RESIZE(T, name) p.name.assign(1, T{});
+    PATH_STATE_BUFFERS(PATH_RESIZE)
+#undef PATH_RESIZE
+    // The previous bounce's glossy point, its cut and state as a previous wave left them.
+    p.shade_P[0] = f4_from3(kP, 0.0f);
+    p.shade_N[0] = f4_from3(kN, uint_as_float_(12345u));
+    p.shade_Ns[0] = f4_from3(kN, uint_as_float_(uint32_t(mats.size() - 1)));
+    p.shade_wo[0] = f4_from3(normalize(make_float3(0.3f, 1, 0)), 0.0f);
+    p.shade_f[0] = make_float4(1, 1, 1, BRDF_POINT_FLAG);
+    p.brdf_state[0] = make_int4(3, 5, 0, 1 | (1 << 16));
+    p.hits[0].prim = -1; // this bounce's ray escaped
+    p.ray_d[0] = make_float4(0, 1, 0, 0);
+    PathBuffers pb = p.host();
+    int2 shaded = shade_surface_item(0, 1, 3, &sc, &pb, &ls);
+    EXPECT_EQ(shaded.x, 0);
+    EXPECT_EQ(shaded.y, 0);
+    int2 c = brdf_cut_item(0, &ls, &sc, &pb);
+    EXPECT_EQ(c.x, 0);
+    std::vector<BrdfItem> stage(BRDF_MAX_BATCH);
+    for (int round = 0; round < brdf_rounds_for(50); ++round)
+      EXPECT_EQ(brdf_sample_item(0, round, &ls, &sc, &pb, stage.data()), 0) << "round " << round;
+    EXPECT_EQ(p.radiance[0].x, 0.0f);
+  }
 }
