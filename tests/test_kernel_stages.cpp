@@ -165,6 +165,7 @@ protected:
       p.shade_wo.push_back(make_float4(0, 0, 0, 0));
       p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
       p.brdf_state.push_back(make_int4(0, 0, 0, 0));
+      p.brdf_share.push_back(0.0f);
     }
     return p;
   }
@@ -367,29 +368,32 @@ void KernelStages::check_brdf_cut(KernelArgs& args, const LightSamplerCtx& ls,
                                   const std::vector<int>& queue) {
   std::vector<float2> zeros(host_cut_.size(), make_float2(0, 0));
   cl::Buffer b_cut = to_device(rt_, zeros);
-  cl::Buffer b_counters = to_device(rt_, std::vector<int>(3, 0));
+  cl::Buffer b_counters = to_device(rt_, std::vector<int>(4, 0));
   args.set("brdf_cut", b_cut);
   args.set("brdf_counters", b_counters);
   BoundKernel k(program_, "brdf_cut", args);
   enqueue_1d(rt_.queue(), k.bind({{"queue", to_device(rt_, queue)}, {"count", kPaths}}), kPaths);
   std::vector<float2> dcut = from_device<float2>(rt_, b_cut, host_cut_.size());
   std::vector<int4> dstate = from_device<int4>(rt_, args.buffer("brdf_state"), kPaths);
-  std::vector<int> dcounters = from_device<int>(rt_, b_counters, 3);
+  std::vector<float> dshare = from_device<float>(rt_, args.buffer("brdf_share"), kPaths);
+  std::vector<int> dcounters = from_device<int>(rt_, b_counters, 4);
 
   PathBuffers pb = ref.host();
-  int glossy = 0, cut_sum = 0, n_sum = 0;
+  int glossy = 0, cut_sum = 0, n_sum = 0, n_max = 0;
   for (int path : queue) {
     if (pb.brdf_state[path].y != -1) continue;
     int2 r = brdf_cut_item(path, &ls, &sc, &pb);
-    ++glossy, cut_sum += r.x, n_sum += r.y;
+    ++glossy, cut_sum += r.x, n_sum += r.y, n_max = std::max(n_max, r.y);
   }
-  EXPECT_EQ(dcounters, (std::vector<int>{glossy, cut_sum, n_sum}));
+  // (glossy points, sum of cut sizes, sum of N, largest N)
+  EXPECT_EQ(dcounters, (std::vector<int>{glossy, cut_sum, n_sum, n_max}));
   for (int path : queue) {
     size_t p = size_t(path);
     int4 d = dstate[p], h = ref.brdf_state[p];
     ASSERT_TRUE(d.x == h.x && d.y == h.y && d.z == h.z && d.w == h.w)
         << "path " << path << ": device (" << d.x << ", " << d.y << ", " << d.z << ", " << d.w
         << ") host (" << h.x << ", " << h.y << ", " << h.z << ", " << h.w << ")";
+    expect_close(dshare[p], ref.brdf_share[p], "path " + std::to_string(path) + " share");
     for (int j = 0; j < h.x; ++j) {
       size_t e = p * LT_BRDF_MAX_CUT + size_t(j);
       ASSERT_EQ(float_as_uint_(dcut[e].x), float_as_uint_(host_cut_[e].x))

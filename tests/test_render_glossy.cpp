@@ -161,6 +161,27 @@ double check_render(Scene& scene, const RendererOptions& opt, int spp, const Rad
   return total_bound / total_ref;
 }
 
+// A sampler configuration by name: a light sampler, or "brdf-mis-equal" (brdf-mis with equal
+// allocation, the ablation of Liu et al. Fig. 8), or "<sampler>/nomis".
+RendererOptions sampler_options(std::string name) {
+  RendererOptions opt;
+  if (name.size() > 6 && name.compare(name.size() - 6, 6, "/nomis") == 0) {
+    opt.mis = false;
+    name.resize(name.size() - 6);
+  }
+  if (name == "brdf-mis-equal") {
+    name = "brdf-mis";
+    opt.brdf.adaptive = false;
+  }
+  opt.light_sampler = name;
+  return opt;
+}
+std::string param_name(std::string s) {
+  for (char& c : s)
+    if (c == '-' || c == '/') c = '_';
+  return s;
+}
+
 struct PointLightDesc {
   D3 p, I;
 };
@@ -188,6 +209,12 @@ std::string points_json() {
 class GlossyPointLights
     : public ::testing::TestWithParam<std::tuple<std::string, std::string, float>> {};
 
+std::string
+point_lights_name(const ::testing::TestParamInfo<std::tuple<std::string, std::string, float>>& p) {
+  return param_name(std::get<0>(p.param) + "_" + std::get<1>(p.param) + "_r" +
+                    std::to_string(int(std::get<2>(p.param) * 100.0f + 0.5f)));
+}
+
 TEST_P(GlossyPointLights, PixelMeansMatchTheExactRadiance) {
   const auto& [sampler, material, roughness] = GetParam();
   Material m = material == "conductor" ? conductor(roughness) : plastic(roughness);
@@ -204,8 +231,7 @@ TEST_P(GlossyPointLights, PixelMeansMatchTheExactRadiance) {
     }
     return sum;
   };
-  RendererOptions opt;
-  opt.light_sampler = sampler;
+  RendererOptions opt = sampler_options(sampler);
   double rel = check_render(scene, opt, 2048, L, L, 16, 8);
   // The test's resolving power: the image-wide bound (5 standard errors plus the reference's
   // quadrature error) must stay small enough that a wrong factor (Fresnel, G2, 1/4) fails it.
@@ -215,25 +241,26 @@ TEST_P(GlossyPointLights, PixelMeansMatchTheExactRadiance) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Materials, GlossyPointLights,
-                         ::testing::Combine(::testing::Values("power", "tree-split"),
+                         ::testing::Combine(::testing::Values("power", "tree-split", "brdf-mis"),
                                             ::testing::Values("conductor", "plastic"),
                                             ::testing::Values(0.3f, 0.6f)),
-                         [](const auto& p) {
-                           std::string name =
-                               std::get<0>(p.param) + "_" + std::get<1>(p.param) + "_r" +
-                               std::to_string(int(std::get<2>(p.param) * 100.0f + 0.5f));
-                           for (char& c : name)
-                             if (c == '-') c = '_';
-                           return name;
-                         });
+                         point_lights_name);
+// The ablations of brdf-mis (Liu et al. Fig. 8, 14c) at the sharper roughness.
+INSTANTIATE_TEST_SUITE_P(BrdfAblations, GlossyPointLights,
+                         ::testing::Combine(::testing::Values("brdf-mis-equal", "brdf-oriented"),
+                                            ::testing::Values("conductor", "plastic"),
+                                            ::testing::Values(0.3f)),
+                         point_lights_name);
 
 // A one-sided 1 x 0.6 quad light facing the plane, outside the camera's view; its glossy
 // reflection is in view. Both techniques find it (max_depth 2: one BSDF bounce), so the test
 // covers MIS; without MIS light sampling alone must give the same answer.
-class GlossyQuadLight : public ::testing::TestWithParam<std::tuple<std::string, float, bool>> {};
+// brdf-mis (adaptive and equal) and brdf-oriented add their BSDF probes and BRDF-oriented samples.
+class GlossyQuadLight
+    : public ::testing::TestWithParam<std::tuple<std::string, std::string, float>> {};
 
 TEST_P(GlossyQuadLight, PixelMeansMatchQuadratureOverTheLight) {
-  const auto& [material, roughness, mis] = GetParam();
+  const auto& [sampler, material, roughness] = GetParam();
   Material m = material == "conductor" ? conductor(roughness) : plastic(roughness);
   const D3 corner{-0.5, 2.8, 1.6}, e1{1.0, 0.0, 0.0}, e2{0.0, -0.4, 0.4};
   const D3 Le{3.0, 2.0, 1.0};
@@ -263,19 +290,17 @@ TEST_P(GlossyQuadLight, PixelMeansMatchQuadratureOverTheLight) {
       return sum * (area / (k * k));
     };
   };
-  RendererOptions opt;
-  opt.light_sampler = "tree-split";
-  opt.mis = mis;
+  RendererOptions opt = sampler_options(sampler);
   double rel = check_render(scene, opt, 512, quadrature(40), quadrature(20), 4, 2);
   EXPECT_LT(rel, 0.02);
 }
 
-INSTANTIATE_TEST_SUITE_P(Materials, GlossyQuadLight,
-                         ::testing::Combine(::testing::Values("conductor", "plastic"),
-                                            ::testing::Values(0.45f),
-                                            ::testing::Values(true, false)),
-                         [](const auto& p) {
-                           return std::get<0>(p.param) + "_r" +
-                                  std::to_string(int(std::get<1>(p.param) * 100.0f + 0.5f)) +
-                                  (std::get<2>(p.param) ? "_mis" : "_nomis");
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Materials, GlossyQuadLight,
+    ::testing::Combine(::testing::Values("tree-split", "tree-split/nomis", "brdf-mis",
+                                         "brdf-mis-equal", "brdf-oriented"),
+                       ::testing::Values("conductor", "plastic"), ::testing::Values(0.45f)),
+    [](const auto& p) {
+      return param_name(std::get<0>(p.param) + "_" + std::get<1>(p.param) + "_r" +
+                        std::to_string(int(std::get<2>(p.param) * 100.0f + 0.5f)));
+    });

@@ -2,7 +2,7 @@
 // the brdf-mis and brdf-oriented samplers. Per glossy point:
 // - brdf_cut_item (§4.1): the point's light cut by the BRDF cap integral S_C, stored with the
 //   cluster importances, and the number N of BRDF-aware samples: N = ceil(N_max I_B), I_B = max
-//   S_C over the cut (§5, Eq. 8-9), at most N_max; 2 with equal allocation; 1 for brdf-oriented.
+//   S_C over the cut (§5, Eq. 8-9), in [1, N_max]; 2 with equal allocation; 1 for brdf-oriented.
 // - tree light sampling with splitting (light_pick.h) runs as for any point, its samples weighted
 //   by brdf_weight_tree (brdf-mis only).
 // - rounds of brdf_sample_item / brdf_trace_item / brdf_accumulate_item draw the N samples (§5,
@@ -14,15 +14,18 @@
 //
 // Unbiasedness with adaptive counts (DESIGN "MIS with splitting", extended): the tree estimate
 // (one sample, density p_L) gets the power-heuristic weight w_L = p_L^2 / (p_L^2 + (N q)^2) with
-// the fixed density q = (p_B + p_S) / 2, and each BRDF-aware sample i the weight (1 - w_L) / N
-// divided by its own density q_i = p_i p_B + (1 - p_i) p_S, where p_i is known before the sample
-// is drawn. w_L + (1 - w_L) = 1 for every light point, and each BRDF-aware sample is unbiased for
-// (1 - w_L) f / N given the samples before it, so the sum is unbiased however p_i adapts. (Weights
-// computed from the realised counts, as a plain reading of the paper suggests, would depend on the
-// samples they weight and bias the estimate.) Equal allocation (adaptive = false) draws one sample
-// of each technique (p_i = 1/2 stratified: sample 0 light, sample 1 BSDF; q_i = q), which makes
-// the weights exactly the power heuristic over the three techniques with counts 1, 1, 1 up to the
-// grouping of the BRDF-aware two. brdf-oriented alone: p_i = 1, no tree estimate (w_L = 0).
+// a density q = s p_B + (1 - s) p_S fixed before any BRDF-aware sample is drawn, and each
+// BRDF-aware sample i the weight (1 - w_L) / N divided by its own density q_i = p_i p_B +
+// (1 - p_i) p_S, where p_i is known before the sample is drawn. w_L + (1 - w_L) = 1 for every light
+// point, and each BRDF-aware sample is unbiased for (1 - w_L) f / N given the samples before it,
+// so the sum is unbiased however p_i adapts. (Weights computed from the realised counts, as a
+// plain reading of the paper suggests, would depend on the samples they weight and bias the
+// estimate.) The share s is the mean of p_i over the N samples if no BSDF sample finds an emitter
+// (brdf_expected_share), the case BRDF-oriented sampling is for; there q matches the samples'
+// densities. Equal allocation (adaptive = false) draws one sample of each technique (s = p_i = 1/2,
+// stratified: sample 0 light, sample 1 BSDF; q_i = q), which makes the weights exactly the power
+// heuristic over the three techniques with counts 1, 1, 1 up to the grouping of the BRDF-aware
+// two. brdf-oriented alone: p_i = 1, no tree estimate (w_L = 0).
 //
 // The BSDF samples replace the path's own bounce for direct lighting: emission found by the
 // continuation ray from a glossy point is not counted (shade_surface.h), as the point's direct
@@ -45,8 +48,6 @@
 #define BRDF_MAX_BATCH 32
 // shade_f.w of a glossy point under a BRDF sampler (0 and 1: see path_state.h).
 #define BRDF_POINT_FLAG 2.0f
-// Upper bound of N_max (the scene/CLI parameter; it bounds the per-point work).
-#define BRDF_MAX_SAMPLES 1024
 
 // Samples drawn in round r: 1, 1, 2, 4, ..., BRDF_MAX_BATCH.
 INLINE int brdf_round_batch(int round) {
@@ -55,7 +56,8 @@ INLINE int brdf_round_batch(int round) {
 // Rounds needed to draw n samples.
 INLINE int brdf_rounds_for(int n) {
   int r = 0, drawn = 0;
-  while (drawn < n) drawn += brdf_round_batch(r++);
+  while (drawn < n)
+    drawn += brdf_round_batch(r++);
   return r;
 }
 
@@ -79,8 +81,8 @@ typedef struct BrdfPoint {
   int4 state;         // brdf_state: cut size, N, samples drawn, n_hit | n_nohit << 16
 } BrdfPoint;
 
-INLINE BrdfPoint brdf_point(const LightSamplerCtx* ls, const SceneBuffers* sc, const PathBuffers* pb,
-                            int path) {
+INLINE BrdfPoint brdf_point(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                            const PathBuffers* pb, int path) {
   BrdfPoint bp;
   bp.P = xyz_of(pb->shade_P[path]);
   bp.N = xyz_of(pb->shade_N[path]);
@@ -100,10 +102,26 @@ INLINE float brdf_light_pmf(const LightSamplerCtx* ls, const BrdfPoint* bp, int 
   return lt_brdf_pmf(&ls->tree, bp->cut, bp->state.x, bp->P, bp->N, &bp->lobe, light);
 }
 
-// Weight of the tree light sample (density p_L) against N BRDF-aware samples (see the top).
-INLINE float brdf_weight_tree(const LightSamplerCtx* ls, float p_L, float p_B, float p_S, int N) {
+// Weight of the tree light sample (density p_L) against N BRDF-aware samples drawn with share s
+// of BRDF-oriented light sampling (see the top).
+INLINE float brdf_weight_tree(const LightSamplerCtx* ls, float p_L, float p_B, float p_S, int N,
+                              float s) {
   if (ls->kind == SAMPLER_BRDF_ORIENTED) return 0.0f;
-  return power_heuristic(p_L, (float)N * 0.5f * (p_B + p_S));
+  return power_heuristic(p_L, (float)N * (s * p_B + (1.0f - s) * p_S));
+}
+
+// Mean of Alg. 1's p over N samples when every BSDF sample misses, in the fluid limit: after
+// sample i the expected misses grow by 1 - p_i (Eq. 7 with n_hit = 1).
+INLINE float brdf_expected_share(const LightSamplerCtx* ls, int N) {
+  if (ls->kind == SAMPLER_BRDF_ORIENTED) return 1.0f;
+  if (!ls->brdf_adaptive) return 0.5f;
+  float misses = 1.0f, sum = 0.0f;
+  for (int i = 0; i < N; ++i) {
+    float p = misses / (misses + ls->brdf_lambda);
+    sum += p;
+    misses += 1.0f - p;
+  }
+  return N > 0 ? sum / (float)N : 1.0f;
 }
 
 // Probability of choosing BRDF-oriented light sampling for the next samples (Eq. 7), or 1/2 for
@@ -128,10 +146,11 @@ INLINE int2 brdf_cut_item(int path, const LightSamplerCtx* ls, const SceneBuffer
     N = 1;
   else if (!ls->brdf_adaptive)
     N = 2;
-  else // Eq. 9, rounded up so that any point whose BRDF reaches a light gets a sample
-    N = I_B > 0.0f ? (int)fmin(ceil((float)ls->brdf_nmax * I_B), (float)ls->brdf_nmax) : 0;
-  if (n == 0) N = 0;
+  else // Eq. 9, at least 1: a cut of point lights has I_B = 0 (caps without solid angle)
+    N = (int)fmax(fmin(ceil((float)ls->brdf_nmax * I_B), (float)ls->brdf_nmax), 1.0f);
+  if (n == 0) N = 0;                                        // no light can reach the point
   pb->brdf_state[path] = make_int4(n, N, 0, 1 | (1 << 16)); // n_hit = n_nohit = 1 (Alg. 1)
+  pb->brdf_share[path] = brdf_expected_share(ls, N);
   return make_int2(n, N);
 }
 
@@ -173,7 +192,7 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
       if (ls->kind != SAMPLER_BRDF_ORIENTED)
         p_L = lt_pmf_split(&ls->tree, bp.P, bp.N, light, ls->threshold, ls->max_cut) * lp.s.pdf;
       float q = p_i * p_B + (1.0f - p_i) * lp.bsdf_pdf;
-      float w = 1.0f - brdf_weight_tree(ls, p_L, p_B, lp.bsdf_pdf, st.y);
+      float w = 1.0f - brdf_weight_tree(ls, p_L, p_B, lp.bsdf_pdf, st.y, pb->brdf_share[path]);
       float3 c = beta * lp.f_cos * lp.s.Li * (w * inv_n / q);
       if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) continue;
       it.origin = lp.origin;
@@ -193,8 +212,8 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
       it.origin = f4_from3(bp.P, alive ? FLT_INF : 0.0f);
       it.dir = f4_from3(wi, uint_as_float_((uint)path));
       // f cos = weight pdf
-      it.value = f4_from3(alive ? beta * bs.weight * (bs.pdf * inv_n) : make_float3(0.0f, 0.0f, 0.0f),
-                          0.0f);
+      it.value = f4_from3(
+          alive ? beta * bs.weight * (bs.pdf * inv_n) : make_float3(0.0f, 0.0f, 0.0f), 0.0f);
       it.extra = make_float4(alive ? bs.pdf : 0.0f, p_i, (float)BRDF_ITEM_BSDF, 0.0f);
     }
     out[written++] = it;
@@ -206,8 +225,8 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
 // Stage brdf_trace, one item: a light sample's shadow ray (zeroed if occluded), or a BSDF probe's
 // closest hit: if it is an emitter seen from its emitting side, the probe's contribution is
 // Le f cos (1 - w_L) / (N q) with the densities of the three techniques at the hit.
-INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls, const SceneBuffers* sc,
-                            const PathBuffers* pb) {
+INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls,
+                            const SceneBuffers* sc, const PathBuffers* pb) {
   BrdfItem it = *item;
   float3 o = xyz_of(it.origin), d = xyz_of(it.dir);
   Hit h;
@@ -241,7 +260,7 @@ INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls, co
     p_L = lt_pmf_split(&ls->tree, bp.P, bp.N, light, ls->threshold, ls->max_cut) * pdf_y;
   float p_S = it.extra.x, p_i = it.extra.y;
   float q = p_i * p_B + (1.0f - p_i) * p_S;
-  float w = 1.0f - brdf_weight_tree(ls, p_L, p_B, p_S, bp.state.y);
+  float w = 1.0f - brdf_weight_tree(ls, p_L, p_B, p_S, bp.state.y, pb->brdf_share[path]);
   item->value = f4_from3(xyz_of(it.value) * Le * (w / q), 0.0f);
   item->extra.w = 1.0f;
 }

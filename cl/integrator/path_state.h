@@ -33,7 +33,9 @@
   X(float4, shade_Ns)                                                                              \
   /* brdf-mis, brdf-oriented (brdf_mis.h): x: cut size, y: BRDF-aware samples N (-1: a glossy */   \
   /* point whose cut is not built yet), z: samples drawn, w: n_hit | n_nohit << 16 (Alg. 1) */     \
-  X(int4, brdf_state)
+  X(int4, brdf_state)                                                                              \
+  /* brdf-mis: the share of BRDF-oriented light samples the tree sample's MIS weight assumes */    \
+  X(float, brdf_share)
 
 // The scene's buffers, likewise: X(element type, name), read-only on the device.
 #define SCENE_BUFFERS(X)                                                                           \

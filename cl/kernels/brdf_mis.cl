@@ -8,7 +8,8 @@
 #if HAS_BRDF_ORIENTED
 
 // The cut of each glossy point of this bounce. brdf_counters: (glossy points, sum of cut sizes,
-// sum of N) of the wave, for --stats (integer atomics: the totals do not depend on the order).
+// sum of N) of the wave, for --stats (integer atomics: the totals do not depend on the order),
+// and the largest N of the bounce, which sets its number of rounds.
 __kernel void brdf_cut(__global const int* queue, int count, PATH_PARAMS SCENE_PARAMS
                        LIGHT_SAMPLER_PARAMS __global int* brdf_counters) {
   int i = get_global_id(0);
@@ -22,6 +23,7 @@ __kernel void brdf_cut(__global const int* queue, int count, PATH_PARAMS SCENE_P
   atomic_inc(&brdf_counters[0]);
   atomic_add(&brdf_counters[1], r.x);
   atomic_add(&brdf_counters[2], r.y);
+  atomic_max(&brdf_counters[3], r.y);
 }
 
 // One round's samples of each point, staged in its own BRDF_MAX_BATCH slots.

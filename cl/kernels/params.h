@@ -38,7 +38,7 @@
       __global const float *alias_prob, __global const int *alias_index,                           \
       __global const float4 *lt_nodes, __global const int4 *lt_children,                           \
       __global const int *lt_leaf_lights, __global const uint *lt_trails, float4 lt_root_sphere,   \
-      float4 lt_root_info, float split_threshold, uint max_cut, __global float2 *brdf_cut,       \
+      float4 lt_root_info, float split_threshold, uint max_cut, __global float2 *brdf_cut,         \
       float brdf_delta, float brdf_lambda, int brdf_nmax, int brdf_adaptive,
 
 #define LIGHT_SAMPLER_ASSEMBLE(ls)                                                                 \

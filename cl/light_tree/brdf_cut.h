@@ -26,7 +26,7 @@
 // BRDF lobe `lobe`; S_C of each lane in *S and whether P is inside its bounding sphere in
 // *inside. A lane is 0 where none of its emitters can reach P's reflecting side: no energy, the
 // orientation cone or half-space bound excludes P (lt_view_v), the cap is below the geometric
-// horizon, or the BRDF is 0 over the cap (S_C = 0). Inside the sphere the cap is the whole sphere
+// horizon, or the BRDF's mean over the cap is 0. Inside the sphere the cap is the whole sphere
 // and d^2 is clamped at (r/2)^2 as in lt_importance_v.
 LT_HOT float4 lt_brdf_importance4(const LtLanes* l, float3 P, float3 Ng, const CapLobe* lobe,
                                   float4* S, int4* inside) {
@@ -53,9 +53,9 @@ LT_HOT float4 lt_brdf_importance4(const LtLanes* l, float3 P, float3 Ng, const C
     float si = sqrt(fmax(1.0f - ci * ci, 0.0f));
     if (!in[k] && !(ci >= cu || ci * cu + si * su > 0.0f)) continue;
     float mean;
+    // The BRDF's mean over the cap decides, not S_C: a point light's cap has no solid angle (S_C
+    // = 0) but the BRDF towards it is its mean.
     s[k] = cap_lobe_integral(lobe, c, su, cu, &mean);
-    // Culled by the mean S_C / Omega_C alone: a point light's cap has Omega_C = S_C = 0 but a
-    // positive mean (the BRDF towards it).
     if (!(mean > 0.0f)) {
       s[k] = 0.0f;
       continue;
@@ -94,8 +94,8 @@ INLINE int lt_code_splittable(int code) {
 // LT_BRDF_MAX_CUT entries. Clusters of importance 0 are left out (none of their lights can reach
 // P). Writes entries (code bits, importance) to cut[0..count) and returns count; *I_B = max S_C
 // over the cut (Eq. 8).
-INLINE int lt_brdf_cut_build(const LtTree* t, float3 P, float3 Ng, const CapLobe* lobe,
-                             float delta, GLOBAL float2* cut, float* I_B) {
+INLINE int lt_brdf_cut_build(const LtTree* t, float3 P, float3 Ng, const CapLobe* lobe, float delta,
+                             GLOBAL float2* cut, float* I_B) {
   int stack_code[LT_BRDF_MAX_CUT];
   float stack_imp[LT_BRDF_MAX_CUT], stack_s[LT_BRDF_MAX_CUT];
   int n = 0, top = 0;

@@ -24,11 +24,11 @@ LT_HOT v4f lt_vcross_len(v4f ax, v4f ay, v4f az, v4f dx, v4f dy, v4f dz) {
 // ---------------------------------------------------------------- cluster importance (Eq. 3)
 // The four lanes (clusters or emitters) a node or a leaf ranks, decoded from its records.
 typedef struct LtLanes {
-  v4f cx, cy, cz, r;  // bounding spheres
-  v4f ax, ay, az;     // cone axes (0 when every lane's cone is the full sphere)
-  v4f cos_o, cos_e;   // cone: normal bound theta_o, emission bound theta_e
-  v4f energy;         // 0: unused lane
-  v4f plane_h;        // half-space bound offset (LT_PLANE_NONE: none)
+  v4f cx, cy, cz, r; // bounding spheres
+  v4f ax, ay, az;    // cone axes (0 when every lane's cone is the full sphere)
+  v4f cos_o, cos_e;  // cone: normal bound theta_o, emission bound theta_e
+  v4f energy;        // 0: unused lane
+  v4f plane_h;       // half-space bound offset (LT_PLANE_NONE: none)
 } LtLanes;
 
 // The geometry of four clusters seen from P, shared by the importance of Conty Estevez & Kulla
@@ -77,8 +77,8 @@ LT_HOT LtView lt_view_v(const LtLanes* l, float3 P) {
       v4_sub(zero, v4_add(v4_add(v4_mul(l->ax, v.dx), v4_mul(l->ay, v.dy)), v4_mul(l->az, v.dz))),
       v.inv_d);
   // half-space bound: dot(a, P - c) / d > -(h / d + slope), else every emitter faces away from P
-  v.front = v4_gt(cos_t, v4_sub(zero, v4_add(v4_mul(l->plane_h, v.inv_d),
-                                              v4_splat(LT_PLANE_SLOPE))));
+  v.front =
+      v4_gt(cos_t, v4_sub(zero, v4_add(v4_mul(l->plane_h, v.inv_d), v4_splat(LT_PLANE_SLOPE))));
   v4f sin_t = v4_min(v4_mul(lt_vcross_len(l->ax, l->ay, l->az, v.dx, v.dy, v.dz), v.inv_d), one);
   v4f sin_o = v4_sqrt(v4_max(v4_sub(one, v4_mul(l->cos_o, l->cos_o)), zero));
   // theta - theta_o, clamped at 0
@@ -226,9 +226,9 @@ LT_HOT LtLanes lt_node_lanes(const LtTree* t, int node, float3* N) {
   v4f k16 = v4_lo16(v4_load(n + LT_CE_CV2));
   v4m plane = v4_gt(cos_o, v4_splat(1.5f)); // LT_PLANE_FLAG: k16 is the plane offset
   l.cos_e = v4_sel(v4_mul(k16, v4_splat(LT_U16_SCALE)), v4_splat(0.0f), plane);
-  l.plane_h =
-      v4_sel(v4_splat(LT_PLANE_NONE),
-             v4_mul(v4_sub(k16, v4_splat(32768.0f)), v4_mul(l.r, v4_splat(LT_PLANE_H_UNIT))), plane);
+  l.plane_h = v4_sel(
+      v4_splat(LT_PLANE_NONE),
+      v4_mul(v4_sub(k16, v4_splat(32768.0f)), v4_mul(l.r, v4_splat(LT_PLANE_H_UNIT))), plane);
   l.cos_o = v4_sel(cos_o, v4_splat(LT_PLANE_COS_O), plane);
   lt_without_orientation(t, &l, N);
   lt_decode_axes(v4_load(n + LT_AXIS), &l);

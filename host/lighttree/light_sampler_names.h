@@ -11,8 +11,7 @@
 namespace canopy {
 
 inline constexpr std::array<std::string_view, 8> kLightSamplerNames = {
-    "uniform", "power",      "tree",    "tree-split", "exhaustive",
-    "bsdf",    "brdf-mis", "brdf-oriented"};
+    "uniform", "power", "tree", "tree-split", "exhaustive", "bsdf", "brdf-mis", "brdf-oriented"};
 static_assert(kLightSamplerNames.size() == SAMPLER_BRDF_ORIENTED + 1,
               "one name per SAMPLER_* kind");
 static_assert(kLightSamplerNames[SAMPLER_UNIFORM] == "uniform" &&

@@ -9,8 +9,8 @@
 namespace canopy {
 
 LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const std::string& name,
-                                         float split_threshold, int max_cut,
-                                         bool orientation_term, const BrdfSettings& brdf) {
+                                         float split_threshold, int max_cut, bool orientation_term,
+                                         const BrdfSettings& brdf) {
   LightSamplerData d;
   d.kind = light_sampler_from_name(name);
   d.brdf = brdf;

@@ -29,8 +29,7 @@ cl::Buffer device_buffer(const cl::Context& ctx, size_t bytes) {
 const std::vector<std::string> kKernelFiles = {
     "kernels/compact.cl",       "kernels/generate.cl",   "kernels/intersect_closest.cl",
     "kernels/shade_surface.cl", "kernels/light_pick.cl", "kernels/intersect_shadow.cl",
-    "kernels/brdf_mis.cl",
-    "kernels/accumulate.cl"};
+    "kernels/brdf_mis.cl",      "kernels/accumulate.cl"};
 
 constexpr int kScanBlock = 256;
 constexpr int kCutBins = 65;
@@ -147,7 +146,8 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_.kind)
                                                  : scene_features(scene, sampler_.kind);
   features.mis = options.mis;
-  brdf_stages_ = sampler_.brdf_oriented() && (features.material_conductor || features.material_plastic);
+  brdf_stages_ =
+      sampler_.brdf_oriented() && (features.material_conductor || features.material_plastic);
   stats_.kernel_options = features.build_options();
   program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
@@ -216,7 +216,7 @@ Film Renderer::render(const RenderSettings& settings) {
   buffer("brdf_stage", brdf_paths * BRDF_MAX_BATCH * sizeof(BrdfItem));
   buffer("brdf_items", brdf_paths * BRDF_MAX_BATCH * sizeof(BrdfItem));
   cl::Buffer counts_brdf = buffer("counts_brdf", brdf_paths * sizeof(cl_int2));
-  cl::Buffer brdf_counters = buffer("brdf_counters", 3 * sizeof(cl_int));
+  cl::Buffer brdf_counters = buffer("brdf_counters", 4 * sizeof(cl_int));
   buffer("offsets", split_cap * sizeof(cl_int2));
   buffer("block_sums", (split_cap / kScanBlock + 2) * sizeof(cl_int2));
   cl::Buffer totals = buffer("totals", 2 * sizeof(cl_int));
@@ -233,7 +233,7 @@ Film Renderer::render(const RenderSettings& settings) {
   // (at most W * max_depth events) and are added into the 64-bit stats after each wave: a whole
   // render at 2^24 spp has more than 2^31 samples.
   auto reset_counters = [&] {
-    q.enqueueFillBuffer(brdf_counters, cl_int(0), 0, 3 * sizeof(cl_int));
+    q.enqueueFillBuffer(brdf_counters, cl_int(0), 0, 4 * sizeof(cl_int));
     q.enqueueFillBuffer(nonfinite, cl_int(0), 0, sizeof(cl_int));
     q.enqueueFillBuffer(histogram, cl_int(0), 0, kCutBins * sizeof(cl_int));
   };
@@ -260,9 +260,6 @@ Film Renderer::render(const RenderSettings& settings) {
     k_brdf_trace.emplace(program_, "brdf_trace", args);
     k_brdf_sum.emplace(program_, "brdf_accumulate", args);
   }
-  // Rounds of BRDF-aware samples per bounce: enough for the largest N (brdf_mis.h).
-  const int brdf_rounds = brdf_rounds_for(
-      sampler_.kind == SAMPLER_BRDF_ORIENTED ? 1 : (sampler_.brdf.adaptive ? sampler_.brdf.n_max : 2));
 
   std::vector<std::pair<const char*, cl::Event>> events;
   // Arguments are bound (and checked) even when there is no work.
@@ -307,8 +304,14 @@ Film Renderer::render(const RenderSettings& settings) {
       stats_.shading_points += uint64_t(shade_count);
       q.enqueueFillBuffer(cut_size, cl_int(0), 0, W * sizeof(cl_int));
       // The BRDF-oriented cuts first: tree light samples at glossy points are weighted with them.
-      if (brdf_stages_)
+      int brdf_rounds = 0; // enough for the bounce's largest N (brdf_mis.h)
+      if (brdf_stages_) {
+        q.enqueueFillBuffer(brdf_counters, cl_int(0), 3 * sizeof(cl_int), sizeof(cl_int));
         run("brdf_cut", k_brdf_cut->bind({{"queue", *q_in}, {"count", count}}), size_t(count));
+        cl_int max_n = 0;
+        q.enqueueReadBuffer(brdf_counters, CL_TRUE, 3 * sizeof(cl_int), sizeof(cl_int), &max_n);
+        brdf_rounds = brdf_rounds_for(max_n);
+      }
 
       // Split passes: each pass consumes one level of the cut (DESIGN §4).
       cl::Buffer* s_in = &split_a;
@@ -327,7 +330,7 @@ Film Renderer::render(const RenderSettings& settings) {
         n = n_children;
       }
       // Rounds of BRDF-aware samples at glossy points (Alg. 1 in batches, brdf_mis.h).
-      for (int round = 0; brdf_stages_ && round < brdf_rounds; ++round) {
+      for (int round = 0; round < brdf_rounds; ++round) {
         run("brdf_sample",
             k_brdf_sample->bind({{"queue", *q_in}, {"count", count}, {"brdf_round", round}}),
             size_t(count));
@@ -357,7 +360,7 @@ Film Renderer::render(const RenderSettings& settings) {
     q.enqueueReadBuffer(histogram, CL_TRUE, 0, kCutBins * sizeof(cl_int), hist.data());
     stats_.nonfinite_samples += uint64_t(uint32_t(nf));
     if (brdf_stages_) {
-      cl_int bc[3];
+      cl_int bc[3]; // the wave's totals (brdf_counters[3] is per bounce)
       q.enqueueReadBuffer(brdf_counters, CL_TRUE, 0, sizeof(bc), bc);
       stats_.glossy_points += uint64_t(uint32_t(bc[0]));
       stats_.brdf_cut_sum += uint64_t(uint32_t(bc[1]));

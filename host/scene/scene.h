@@ -74,7 +74,7 @@ struct FilmSettings {
 struct IntegratorSettings {
   int spp = 16;      // samples per pixel, 1 .. kMaxSpp
   int max_depth = 5; // path vertices after the camera hit: 1 = direct light only
-  std::string light_sampler = "tree-split"; // a name of kLightSamplerNames
+  std::string light_sampler = "tree-split";           // a name of kLightSamplerNames
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD; // adaptive splitting threshold in [0, 1]
   int max_cut = kDefaultMaxCut; // tree-split: at most this many lights per shading point
   uint32_t seed = 1;
