@@ -200,7 +200,10 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
       it.value = f4_from3(c, 0.0f);
       it.extra = make_float4(lp.bsdf_pdf, p_i, (float)BRDF_ITEM_LIGHT, 0.0f);
     } else {
-      float3 u = make_float3(lt_rng_next(&rng), lt_rng_next(&rng), lt_rng_next(&rng));
+      // One declarator each: the order of a call's arguments is unspecified (host and device
+      // compilers differ), that of declarators is not.
+      float u1 = lt_rng_next(&rng), u2 = lt_rng_next(&rng), u3 = lt_rng_next(&rng);
+      float3 u = make_float3(u1, u2, u3);
       BsdfSample bs = bsdf_sample(&bp.m, bp.wo_local, u);
       float3 wi = normalize(frame_to_world(&bp.fr, bs.wi));
       // Absorbed, delta or into the geometric surface: a probe that finds nothing (a miss for
