@@ -10,6 +10,8 @@
 #include "light_tree/brdf_cut.h"
 #include "lighttree/light_tree.h"
 
+#include "support/glossy_points.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,22 +23,11 @@ using namespace canopy::test;
 
 namespace {
 
-Material conductor(float roughness) { // gold-like
-  Material m{};
-  m.specular = make_float4(0.18f, 0.42f, 1.37f, 0);
-  m.k = make_float4(3.42f, 2.35f, 1.77f, 0);
-  m.alpha = roughness * roughness;
-  m.type = MATERIAL_CONDUCTOR;
-  return m;
+Material conductor(float roughness) {
+  return gold_conductor(roughness);
 }
 Material plastic(float roughness) {
-  Material m{};
-  m.albedo = make_float4(0.3f, 0.4f, 0.5f, 0);
-  m.specular = make_float4(1, 1, 1, 0);
-  m.ior = 1.5f;
-  m.alpha = roughness * roughness;
-  m.type = MATERIAL_PLASTIC;
-  return m;
+  return blue_plastic(roughness);
 }
 
 // A glossy shading point: position, geometric normal (= shading normal), wo above the surface,

@@ -16,6 +16,8 @@
 #include "render/light_sampler_data.h"
 #include "scene/scene.h"
 
+#include "support/glossy_points.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -23,6 +25,7 @@
 #include <cstdio>
 
 using namespace canopy;
+using namespace canopy::test;
 
 namespace {
 
@@ -81,36 +84,14 @@ const char* kDeltaScene = R"({
   ]
 })";
 
-Material conductor(float roughness) { // gold-like
-  Material m{};
-  m.specular = make_float4(0.18f, 0.42f, 1.37f, 0);
-  m.k = make_float4(3.42f, 2.35f, 1.77f, 0);
-  m.alpha = roughness * roughness;
-  m.type = MATERIAL_CONDUCTOR;
-  return m;
+Material conductor(float roughness) {
+  return gold_conductor(roughness);
 }
 Material plastic(float roughness) {
-  Material m{};
-  m.albedo = make_float4(0.3f, 0.4f, 0.5f, 0);
-  m.specular = make_float4(1, 1, 1, 0);
-  m.ior = 1.5f;
-  m.alpha = roughness * roughness;
-  m.type = MATERIAL_PLASTIC;
-  return m;
+  return blue_plastic(roughness);
 }
 
-struct Paths {
-#define PATH_VECTOR(T, name) std::vector<T> name;
-  PATH_STATE_BUFFERS(PATH_VECTOR)
-#undef PATH_VECTOR
-  PathBuffers host() {
-    PathBuffers pb;
-#define PATH_POINTER(T, name) pb.name = name.data();
-    PATH_STATE_BUFFERS(PATH_POINTER)
-#undef PATH_POINTER
-    return pb;
-  }
-};
+using Paths = canopy::test::HostPaths;
 
 const float3 kP = make_float3(0, 0, 0), kN = make_float3(0, 1, 0);
 

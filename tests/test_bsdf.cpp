@@ -27,6 +27,7 @@
 // half-vector mapping. Each chi-square test passes when its p-value is above 0.01 / kChi2Tests
 // (Bonferroni over all of them). 10^5 samples per case.
 #include "bsdf/bsdf.h"
+#include "support/materials.h"
 
 #include <gtest/gtest.h>
 
@@ -38,6 +39,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+using namespace canopy::test;
 
 namespace {
 
@@ -52,29 +55,6 @@ const float kRoughness[] = {0.001f, 0.01f, 0.1f, 0.3f, 1.0f};
 const float kAnglesDeg[] = {0.0f, 30.0f, 60.0f, 80.0f, 89.9f};
 
 // ---------------------------------------------------------------- materials
-Material make_diffuse(float3 albedo) {
-  Material m{};
-  m.albedo = f4_from3(albedo, 0);
-  m.type = MATERIAL_DIFFUSE;
-  return m;
-}
-Material make_conductor(float3 eta, float3 k, float alpha) {
-  Material m{};
-  m.specular = f4_from3(eta, 0);
-  m.k = f4_from3(k, 0);
-  m.alpha = alpha;
-  m.type = MATERIAL_CONDUCTOR;
-  return m;
-}
-Material make_plastic(float3 albedo, float3 spec, float ior, float alpha) {
-  Material m{};
-  m.albedo = f4_from3(albedo, 0);
-  m.specular = f4_from3(spec, 0);
-  m.ior = ior;
-  m.alpha = alpha;
-  m.type = MATERIAL_PLASTIC;
-  return m;
-}
 // Gold-like (eta, k at ~650/550/450 nm, Johnson & Christy 1972 rounded), and F == 1 (eta = 0).
 Material gold(float alpha) {
   return make_conductor(make_float3(0.18f, 0.42f, 1.37f), make_float3(3.42f, 2.35f, 1.77f), alpha);

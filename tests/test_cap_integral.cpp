@@ -14,6 +14,7 @@
 #include "bsdf/cap_integral.h"
 #include "shading.h"
 #include "support/double3.h"
+#include "support/materials.h"
 
 #include <gtest/gtest.h>
 
@@ -23,6 +24,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+using namespace canopy::test;
 
 namespace {
 
@@ -307,30 +310,8 @@ TEST(CapIntegral, DiffuseMatchesQuadrature) {
 
 namespace {
 
-Material diffuse_mat(float r, float g, float b) {
-  Material m{};
-  m.albedo = make_float4(r, g, b, 0);
-  m.type = MATERIAL_DIFFUSE;
-  return m;
-}
-
-Material conductor_mat(float3 eta, float3 k, float alpha) {
-  Material m{};
-  m.specular = f4_from3(eta, 0);
-  m.k = f4_from3(k, 0);
-  m.alpha = alpha;
-  m.type = MATERIAL_CONDUCTOR;
-  return m;
-}
-
 Material plastic_mat(float alpha) {
-  Material m{};
-  m.albedo = make_float4(0.5f, 0.3f, 0.1f, 0);
-  m.specular = make_float4(1.0f, 0.9f, 0.8f, 0);
-  m.ior = 1.5f;
-  m.alpha = alpha;
-  m.type = MATERIAL_PLASTIC;
-  return m;
+  return make_plastic(make_float3(0.5f, 0.3f, 0.1f), make_float3(1.0f, 0.9f, 0.8f), 1.5f, alpha);
 }
 
 // Conductors (eta, k at R, G, B; pbrt's measured data at ~650, 550, 450 nm).
@@ -445,7 +426,7 @@ TEST(CapIntegral, GlossyMatchesReference) {
   for (double rough : {0.05, 0.1, 0.2, 0.4, 0.7, 1.0}) {
     float alpha = float(rough * rough);
     for (const Metal& mt : kMetals)
-      mats.push_back(conductor_mat(mt.eta, mt.k, alpha));
+      mats.push_back(make_conductor(mt.eta, mt.k, alpha));
     mats.push_back(plastic_mat(alpha));
   }
   // Errors for theta_o <= 60 degrees and for 75, 85 degrees (where the GGX lobe is anisotropic
@@ -494,7 +475,7 @@ TEST(CapIntegral, GlossyMatchesReference) {
 // cosine integral, the whole sphere gives the albedo, and the mean of a vanishing cap tends to
 // albedo / pi cos theta at its centre (exact for a Lambertian lobe, up to float rounding).
 TEST(CapIntegral, DiffuseLobeThroughApi) {
-  Material m = diffuse_mat(0.8f, 0.5f, 0.2f);
+  Material m = make_diffuse(make_float3(0.8f, 0.5f, 0.2f));
   const double rho = (0.8 + 0.5 + 0.2) / 3.0;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -546,7 +527,7 @@ TEST(CapIntegral, SmallCapLimit) {
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (double rough : {0.05, 0.1, 0.2, 0.4, 0.7, 1.0}) {
     for (int mt = 0; mt < 4; ++mt) {
-      Material m = mt < 3 ? conductor_mat(kMetals[mt].eta, kMetals[mt].k, float(rough * rough))
+      Material m = mt < 3 ? make_conductor(kMetals[mt].eta, kMetals[mt].k, float(rough * rough))
                           : plastic_mat(float(rough * rough));
       if (mt == 3) m.albedo = make_float4(0, 0, 0, 0); // the coat alone
       for (double theta_deg : {0.0, 30.0, 60.0, 75.0, 85.0}) {
@@ -594,9 +575,9 @@ TEST(CapIntegral, PositiveAboveHorizonZeroBelowFinite) {
     float alpha = float(std::exp(std::log(1e-4) * u(rng)));
     int type = i % 3;
     if (type == 0)
-      m = diffuse_mat(0.5f, 0.2f, 0.1f);
+      m = make_diffuse(make_float3(0.5f, 0.2f, 0.1f));
     else if (type == 1)
-      m = conductor_mat(kMetals[i % 3].eta, kMetals[i % 3].k, alpha);
+      m = make_conductor(kMetals[i % 3].eta, kMetals[i % 3].k, alpha);
     else
       m = plastic_mat(alpha);
     D3 nw = random_unit(rng);

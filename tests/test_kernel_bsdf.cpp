@@ -14,6 +14,7 @@
 #include "cl/runtime.h"
 #include "render/device_scene.h"
 #include "render/features.h"
+#include "support/probe_program.h"
 
 #include "bsdf/bsdf.h"
 
@@ -26,6 +27,7 @@
 #include <vector>
 
 using namespace canopy;
+using namespace canopy::test;
 
 namespace {
 
@@ -130,13 +132,8 @@ void expect_rel(float dev, float host, float tol, const std::string& what) {
 
 void run_probes(ClRuntime& rt, const std::string& options, const std::vector<Material>& materials,
                 uint32_t seed) {
-  cl::Program program(rt.context(), kProbeKernel);
-  std::string opts = "-I " + kernel_dir().string() + " -cl-std=CL1.2 -Werror " + options;
-  try {
-    program.build({rt.device()}, opts.c_str());
-  } catch (const cl::Error&) {
-    FAIL() << program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(rt.device());
-  }
+  cl::Program program = build_probe_program(rt, kProbeKernel, options);
+  if (::testing::Test::HasFailure()) return;
   Probes p = make_probes(materials, seed);
   const int n = int(p.mats.size());
   const cl::Context& ctx = rt.context();

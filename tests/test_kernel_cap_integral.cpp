@@ -15,6 +15,7 @@
 #include "cl/runtime.h"
 #include "render/device_scene.h"
 #include "render/features.h"
+#include "support/probe_program.h"
 
 #include "bsdf/cap_integral.h"
 
@@ -26,6 +27,7 @@
 #include <vector>
 
 using namespace canopy;
+using namespace canopy::test;
 
 namespace {
 
@@ -78,13 +80,8 @@ Probes make_probes(const std::vector<Material>& materials, uint32_t seed) {
 
 void run(ClRuntime& rt, const std::string& options, const std::vector<Material>& materials,
          uint32_t seed) {
-  cl::Program program(rt.context(), kProbeKernel);
-  std::string opts = "-I " + kernel_dir().string() + " -cl-std=CL1.2 -Werror " + options;
-  try {
-    program.build({rt.device()}, opts.c_str());
-  } catch (const cl::Error&) {
-    FAIL() << program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(rt.device());
-  }
+  cl::Program program = build_probe_program(rt, kProbeKernel, options);
+  if (::testing::Test::HasFailure()) return;
   Probes p = make_probes(materials, seed);
   const int n = int(p.mats.size());
   const cl::Context& ctx = rt.context();

@@ -22,6 +22,8 @@
 #include "render/renderer.h"
 #include "rng.h"
 
+#include "support/glossy_points.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -101,18 +103,7 @@ void expect_close4(float4 a, float4 b, const std::string& what) {
 
 // Host copies of the path state (every buffer of PATH_STATE_BUFFERS), uploaded identically to
 // the device.
-struct Paths {
-#define PATH_VECTOR(T, name) std::vector<T> name;
-  PATH_STATE_BUFFERS(PATH_VECTOR)
-#undef PATH_VECTOR
-  PathBuffers host() {
-    PathBuffers pb;
-#define PATH_POINTER(T, name) pb.name = name.data();
-    PATH_STATE_BUFFERS(PATH_POINTER)
-#undef PATH_POINTER
-    return pb;
-  }
-};
+using Paths = canopy::test::HostPaths;
 
 class KernelStages : public ::testing::TestWithParam<std::string> {
 protected:
