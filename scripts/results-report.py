@@ -61,6 +61,7 @@ BRDF_DEFAULT_DELTA = 0.5
 # Issue 12's targets (equal-time RMSE ratios, render-time ratio).
 TARGET_GLOSSY = 0.8
 TARGET_SCALE = 1.5
+PAPER_SCALE = 20.0 / 11.0  # Fig. 10: 11 s -> 20 s from 10^3 to 10^5 lights
 TARGET_DIFFUSE = 1.05
 # A ratio within this of 1 is not a difference: the seed-to-seed noise of the medians (as above).
 NOISE_MARGIN = 0.05
@@ -489,7 +490,7 @@ def brdf_section(glossy, diffuse, scal, docs):
 
     # (iv) scalability
     o.append("### Scalability with the light count (the paper's Fig. 10)\n")
-    scale_ok = None
+    scale_ok = scale_ratio = None
     if scal:
         counts = sorted(scal)
         samplers = list(dict.fromkeys(l for n in counts for l in scal[n]))
@@ -516,7 +517,7 @@ def brdf_section(glossy, diffuse, scal, docs):
         lo, hi = counts[0], counts[-1]
         if BRDF_MIS in scal[lo] and BRDF_MIS in scal[hi] and hi > lo:
             ratio = scal[hi][BRDF_MIS]["sec_per_spp"] / scal[lo][BRDF_MIS]["sec_per_spp"]
-            scale_ok = ratio <= TARGET_SCALE
+            scale_ok, scale_ratio = ratio <= TARGET_SCALE, ratio
             o.append(f"**Target: brdf-mis render time per sample at {hi:,} lights ≤ {TARGET_SCALE} × "
                      f"at {lo:,}: {met(scale_ok)}** ({hi:,} / {lo:,}: {ratio:.2f}×; the paper: "
                      f"11 s → 20 s, 1.8×, from 1,000 to 100,000 lights).\n")
@@ -625,10 +626,13 @@ def brdf_section(glossy, diffuse, scal, docs):
     claims.append(("A larger δ gives smaller cuts and more BRDF-aware samples (Table 2)",
                    "; ".join(txt) or "not run", verdict(oks)))
     # 6. Scalability.
+    # Reproduced: growth no steeper than the paper's 1.8x (within the noise margin); the issue's
+    # own target (TARGET_SCALE) is stricter and reported above.
     claims.append(("Render time grows slowly with the light count: 1.8× from 10^3 to 10^5 lights "
                    "(Fig. 10)", scale_txt,
-                   "not measured" if scale_ok is None else
-                   ("reproduced" if scale_ok else "not reproduced")))
+                   "not measured" if scale_ratio is None else
+                   ("reproduced" if scale_ratio <= PAPER_SCALE * (1 + NOISE_MARGIN)
+                    else "not reproduced")))
     o.append("### The paper's claims (issue 12)\n")
     o.append("“Reproduced” needs the effect beyond the seed-to-seed noise of the medians "
              f"({NOISE_MARGIN:.0%}) on every scene measured; “partly” means on some.\n")
