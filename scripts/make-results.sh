@@ -40,15 +40,6 @@ if [ -z "${SKIP_BUILD:-}" ]; then
   cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build "$BUILD" -j2 --target canopy
 fi
-# Workaround for a kernel bug (cl/integrator/shade_surface.h as of 03ebcc0 / f9bbb10): a path
-# that escapes the scene returns before its brdf_state is reset, so brdf_cut / brdf_sample read
-# that state from uninitialised memory on the first bounce of a render; reused heap memory then
-# makes them shade a garbage point (bogus radiance, or a segfault in brdf_sample on a material
-# index read from a float). With a fixed mmap threshold, glibc serves every buffer of 64 KiB or
-# more (a wave's path state: W x 16 bytes, W >= 4096) from fresh, zero-filled pages, and a zero
-# state is the correct one for such a path (no BRDF-aware samples). Harmless once the kernel
-# resets the state itself; MALLOC_MMAP_THRESHOLD_= (empty) in the environment keeps glibc's default.
-export MALLOC_MMAP_THRESHOLD_=${MALLOC_MMAP_THRESHOLD_-65536}
 WORK=${WORK:-out/results}
 DOCS=${DOCS:-docs/results}
 REPORT=${REPORT:-docs/results.md}
