@@ -1,7 +1,8 @@
 // Every wavefront kernel on PoCL against a host reference on identical inputs: generate,
 // shade_surface (+ scatter_shade), light_pick (+ scatter_split) for every light sampler, with and
-// without splitting, accumulate_shadow, accumulate, cut_histogram and the scan. The intersect
-// kernels are checked against Embree in test_intersect_embree.cpp.
+// without splitting, the BRDF-oriented stages of brdf-mis / brdf-oriented (brdf_cut, brdf_sample,
+// scatter_brdf, brdf_trace, brdf_accumulate), accumulate_shadow, accumulate, cut_histogram and the
+// scan. The intersect kernels are checked against Embree in test_intersect_embree.cpp.
 //
 // shade_surface and light_pick run the per-item functions of cl/integrator/ on both sides, so
 // these tests prove the device executes them as the host does (address spaces, struct layouts,
@@ -11,6 +12,7 @@
 #include "accel/bvh.h"
 #include "cl/kernel_args.h"
 #include "cl/runtime.h"
+#include "integrator/brdf_mis.h"
 #include "integrator/light_pick.h"
 #include "integrator/shade_surface.h"
 #include "render/camera.h"
@@ -23,6 +25,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 using namespace canopy;
@@ -118,12 +121,19 @@ protected:
     for (const MaterialDesc& m : scene_.materials)
       materials_.push_back(m.gpu);
     geometry_ = build_scene_geometry(scene_, materials_);
-    // "<sampler>-noorient": the orientation ablation (importance E / d^2)
+    // "<sampler>-noorient": the orientation ablation (importance E / d^2); "brdf-mis-equal":
+    // brdf-mis with equal allocation (BrdfSettings::adaptive = false)
     std::string name = GetParam();
-    const std::string suffix = "-noorient";
+    const std::string suffix = "-noorient", equal = "-equal";
     bool orientation = !name.ends_with(suffix);
     if (!orientation) name.resize(name.size() - suffix.size());
-    sampler_ = make_light_sampler_data(scene_.lights, name, 0.85f, 16, orientation);
+    BrdfSettings brdf;
+    if (name.ends_with(equal)) {
+      brdf.adaptive = false;
+      name.resize(name.size() - equal.size());
+    }
+    sampler_ = make_light_sampler_data(scene_.lights, name, 0.85f, 16, orientation, brdf);
+    host_cut_.assign(size_t(kPaths) * LT_BRDF_MAX_CUT, make_float2(0, 0));
     program_ = rt_.build_program(wavefront_kernel_files(),
                                  KernelFeatures::all(sampler_.kind).build_options());
   }
@@ -154,6 +164,8 @@ protected:
       p.shade_f.push_back(make_float4(0, 0, 0, 0));
       p.shade_wo.push_back(make_float4(0, 0, 0, 0));
       p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
+      p.brdf_state.push_back(make_int4(0, 0, 0, 0));
+      p.brdf_share.push_back(0.0f);
     }
     return p;
   }
@@ -171,6 +183,10 @@ protected:
 #undef PATH_DOWNLOAD
     return p;
   }
+  void check_brdf_cut(KernelArgs& args, const LightSamplerCtx& ls, const SceneBuffers& sc,
+                      Paths& ref, const std::vector<int>& queue);
+  void check_brdf_rounds(KernelArgs& args, const LightSamplerCtx& ls, const SceneBuffers& sc,
+                         Paths& ref, const std::vector<int>& queue);
   void upload_scene() {
     dev_ = upload_device_scene(rt_.context(), geometry_, materials_, scene_.lights, sampler_);
   }
@@ -185,6 +201,7 @@ protected:
   std::vector<Material> materials_;
   SceneGeometry geometry_;
   LightSamplerData sampler_;
+  std::vector<float2> host_cut_; // the host's brdf_cut storage (brdf-mis, brdf-oriented)
   cl::Program program_;
   DeviceScene dev_;
 };
@@ -214,7 +231,7 @@ void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& w
 
 TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
   upload_scene();
-  LightSamplerCtx ls = sampler_.host_view(scene_.lights);
+  LightSamplerCtx ls = sampler_.host_view(scene_.lights, host_cut_.data());
   SceneBuffers sc = host_scene();
   Paths paths = make_paths(17);
   std::vector<int> queue(kPaths);
@@ -231,6 +248,9 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     KernelArgs args;
     dev_.set_args(args);
     upload(paths, args);
+    // Every kernel with the light sampler's parameters takes the BRDF cut storage (read by the
+    // brdf-mis / brdf-oriented stages only; check_brdf_cut fills it).
+    args.set("brdf_cut", to_device(rt_, host_cut_));
     cl::Buffer b_counts(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2));
     args.set("counts_shade", b_counts);
     args.set("max_depth", cl_int(3));
@@ -268,6 +288,10 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       if (ref_counts[size_t(i)].y) items.push_back(light_sampler_root(&ls, queue[size_t(i)]));
     upload(ref, args); // the shaded state as the next stage sees it
     PathBuffers pb2 = ref.host();
+    if (sampler_.brdf_oriented()) {
+      check_brdf_cut(args, ls, sc, ref, queue);
+      upload(ref, args); // the cut state as the light_pick passes see it
+    }
     int passes = 0, shadow_total = 0, split_items = 0;
     while (!items.empty()) {
       ASSERT_LT(passes, 40);
@@ -319,6 +343,7 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       items = next;
       ++passes;
     }
+    if (sampler_.brdf_oriented()) check_brdf_rounds(args, ls, sc, ref, queue);
     EXPECT_GT(shadow_total, shaded / 8); // enough shadow items to make the comparison meaningful
     if (sampler_.splits()) {
       EXPECT_GT(split_items, 0); // splitting happened
@@ -335,9 +360,195 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
   }
 }
 
+// brdf_cut on the device and brdf_cut_item on the host, from the same shaded state: the same
+// glossy points, cut sizes, N, cut entries and --stats counters. The host's result (state and
+// cuts) is then the input of both sides' next stages.
+void KernelStages::check_brdf_cut(KernelArgs& args, const LightSamplerCtx& ls,
+                                  const SceneBuffers& sc, Paths& ref,
+                                  const std::vector<int>& queue) {
+  std::vector<float2> zeros(host_cut_.size(), make_float2(0, 0));
+  cl::Buffer b_cut = to_device(rt_, zeros);
+  cl::Buffer b_counters = to_device(rt_, std::vector<int>(4, 0));
+  args.set("brdf_cut", b_cut);
+  args.set("brdf_counters", b_counters);
+  BoundKernel k(program_, "brdf_cut", args);
+  enqueue_1d(rt_.queue(), k.bind({{"queue", to_device(rt_, queue)}, {"count", kPaths}}), kPaths);
+  std::vector<float2> dcut = from_device<float2>(rt_, b_cut, host_cut_.size());
+  std::vector<int4> dstate = from_device<int4>(rt_, args.buffer("brdf_state"), kPaths);
+  std::vector<float> dshare = from_device<float>(rt_, args.buffer("brdf_share"), kPaths);
+  std::vector<int> dcounters = from_device<int>(rt_, b_counters, 4);
+
+  PathBuffers pb = ref.host();
+  int glossy = 0, cut_sum = 0, n_sum = 0, n_max = 0;
+  for (int path : queue) {
+    if (pb.brdf_state[path].y != -1) continue;
+    int2 r = brdf_cut_item(path, &ls, &sc, &pb);
+    ++glossy, cut_sum += r.x, n_sum += r.y, n_max = std::max(n_max, r.y);
+  }
+  // (glossy points, sum of cut sizes, sum of N, largest N)
+  EXPECT_EQ(dcounters, (std::vector<int>{glossy, cut_sum, n_sum, n_max}));
+  for (int path : queue) {
+    size_t p = size_t(path);
+    int4 d = dstate[p], h = ref.brdf_state[p];
+    ASSERT_TRUE(d.x == h.x && d.y == h.y && d.z == h.z && d.w == h.w)
+        << "path " << path << ": device (" << d.x << ", " << d.y << ", " << d.z << ", " << d.w
+        << ") host (" << h.x << ", " << h.y << ", " << h.z << ", " << h.w << ")";
+    expect_close(dshare[p], ref.brdf_share[p], "path " + std::to_string(path) + " share");
+    for (int j = 0; j < h.x; ++j) {
+      size_t e = p * LT_BRDF_MAX_CUT + size_t(j);
+      ASSERT_EQ(float_as_uint_(dcut[e].x), float_as_uint_(host_cut_[e].x))
+          << "path " << path << " entry " << j << " code";
+      expect_close(dcut[e].y, host_cut_[e].y, "cut importance");
+    }
+  }
+  EXPECT_GT(glossy, kPaths / 20); // the scene's glossy materials are shaded
+  EXPECT_GT(cut_sum, glossy);     // cuts of several clusters
+  if (sampler_.kind == SAMPLER_BRDF_MIS && sampler_.brdf.adaptive) {
+    EXPECT_GT(n_sum, glossy); // adaptive N
+  }
+  // Both sides continue from the host's cuts.
+  args.set("brdf_cut", to_device(rt_, host_cut_));
+}
+
+// The rounds of BRDF-aware samples (brdf_rounds_for the sampler's largest N), stage by stage,
+// each from identical inputs: brdf_sample (item counts and staged items, brdf_state),
+// scan + scatter_brdf (compaction in queue order), brdf_trace (each item's value, hit flag),
+// brdf_accumulate (radiance, n_hit / n_nohit, path_counts).
+void KernelStages::check_brdf_rounds(KernelArgs& args, const LightSamplerCtx& ls,
+                                     const SceneBuffers& sc, Paths& ref,
+                                     const std::vector<int>& queue) {
+  const int rounds = brdf_rounds_for(sampler_.kind == SAMPLER_BRDF_ORIENTED ? 1
+                                     : sampler_.brdf.adaptive               ? sampler_.brdf.n_max
+                                                                            : 2);
+  const int block = 256, nblocks = (kPaths + block - 1) / block;
+  int light_items = 0, bsdf_items = 0, bsdf_hits = 0;
+  for (int round = 0; round < rounds; ++round) {
+    SCOPED_TRACE("round " + std::to_string(round));
+    upload(ref, args);
+    // ---- brdf_sample
+    const size_t slots = size_t(kPaths) * BRDF_MAX_BATCH;
+    cl::Buffer b_stage(rt_.context(), CL_MEM_READ_WRITE, slots * sizeof(BrdfItem));
+    cl::Buffer b_counts(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2));
+    args.set("brdf_stage", b_stage);
+    args.set("counts_brdf", b_counts);
+    cl::Buffer b_queue = to_device(rt_, queue);
+    BoundKernel ks(program_, "brdf_sample", args);
+    enqueue_1d(rt_.queue(), ks.bind({{"queue", b_queue}, {"count", kPaths}, {"brdf_round", round}}),
+               kPaths);
+    std::vector<int2> dcounts = from_device<int2>(rt_, b_counts, kPaths);
+    std::vector<BrdfItem> dstage = from_device<BrdfItem>(rt_, b_stage, slots);
+    std::vector<int4> dstate = from_device<int4>(rt_, args.buffer("brdf_state"), kPaths);
+    PathBuffers pb = ref.host();
+    std::vector<BrdfItem> hstage(slots);
+    std::vector<int2> hcounts(kPaths);
+    std::vector<BrdfItem> compact;
+    for (int i = 0; i < kPaths; ++i) {
+      int n = brdf_sample_item(queue[size_t(i)], round, &ls, &sc, &pb,
+                               &hstage[size_t(i) * BRDF_MAX_BATCH]);
+      hcounts[size_t(i)] = make_int2(n, 0);
+      ASSERT_EQ(dcounts[size_t(i)].x, n) << "item " << i;
+      ASSERT_LE(n, brdf_round_batch(round));
+      for (int j = 0; j < n; ++j) {
+        const BrdfItem &d = dstage[size_t(i) * BRDF_MAX_BATCH + size_t(j)],
+                       &h = hstage[size_t(i) * BRDF_MAX_BATCH + size_t(j)];
+        std::string at = "item " + std::to_string(i) + "." + std::to_string(j);
+        ASSERT_EQ(d.extra.z, h.extra.z) << at << " technique";
+        ASSERT_EQ(float_as_uint_(d.dir.w), float_as_uint_(h.dir.w)) << at << " path";
+        // a live probe's tmax is infinite: equal, not close
+        expect_close4(make_float4(d.origin.x, d.origin.y, d.origin.z, 0),
+                      make_float4(h.origin.x, h.origin.y, h.origin.z, 0), at + " origin");
+        if (!(std::isinf(h.origin.w) && d.origin.w == h.origin.w))
+          expect_close(d.origin.w, h.origin.w, at + " tmax");
+        expect_close4(make_float4(d.dir.x, d.dir.y, d.dir.z, 0),
+                      make_float4(h.dir.x, h.dir.y, h.dir.z, 0), at + " dir");
+        expect_close4(d.value, h.value, at + " value");
+        expect_close4(d.extra, h.extra, at + " extra");
+        compact.push_back(h);
+        (h.extra.z == float(BRDF_ITEM_LIGHT) ? light_items : bsdf_items) += 1;
+      }
+    }
+    for (int path : queue) {
+      int4 d = dstate[size_t(path)], h = ref.brdf_state[size_t(path)];
+      ASSERT_TRUE(d.x == h.x && d.y == h.y && d.z == h.z && d.w == h.w) << "path " << path;
+    }
+    if (HasFailure()) return;
+    const int total = int(compact.size());
+    if (total == 0) continue;
+    // ---- scan + scatter_brdf of the host's staged items
+    args.set("brdf_stage", to_device(rt_, hstage));
+    args.set("counts", to_device(rt_, hcounts));
+    args.set("n", cl_int(kPaths));
+    args.set("block", cl_int(block));
+    args.set("nblocks", cl_int(nblocks));
+    args.set("offsets", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2)));
+    args.set("block_sums",
+             cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, size_t(nblocks) * sizeof(int2)));
+    args.set("totals", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, 2 * sizeof(int)));
+    cl::Buffer b_items(rt_.context(), CL_MEM_READ_WRITE, size_t(total) * sizeof(BrdfItem));
+    args.set("brdf_items", b_items);
+    BoundKernel kb(program_, "scan_blocks", args), kt(program_, "scan_block_sums", args),
+        kx(program_, "scatter_brdf", args);
+    enqueue_1d(rt_.queue(), kb.bind(), size_t(nblocks));
+    enqueue_1d(rt_.queue(), kt.bind(), 1);
+    EXPECT_EQ(from_device<int>(rt_, args.buffer("totals"), 1)[0], total);
+    enqueue_1d(rt_.queue(), kx.bind({{"count", kPaths}}), kPaths);
+    std::vector<BrdfItem> ditems = from_device<BrdfItem>(rt_, b_items, size_t(total));
+    for (int i = 0; i < total; ++i)
+      ASSERT_EQ(std::memcmp(&ditems[size_t(i)], &compact[size_t(i)], sizeof(BrdfItem)), 0)
+          << "compacted item " << i;
+    // ---- brdf_trace
+    upload(ref, args); // brdf_state after sampling
+    BoundKernel kr(program_, "brdf_trace", args);
+    enqueue_1d(rt_.queue(), kr.bind({{"count", total}}), size_t(total));
+    ditems = from_device<BrdfItem>(rt_, b_items, size_t(total));
+    for (int i = 0; i < total; ++i) {
+      brdf_trace_item(&compact[size_t(i)], &ls, &sc, &pb);
+      const BrdfItem &d = ditems[size_t(i)], &h = compact[size_t(i)];
+      ASSERT_EQ(d.extra.w, h.extra.w) << "traced item " << i << " hit";
+      expect_close4(d.value, h.value, "traced item " + std::to_string(i) + " value");
+      bsdf_hits += h.extra.z == float(BRDF_ITEM_BSDF) && h.extra.w > 0;
+    }
+    if (HasFailure()) return;
+    // ---- brdf_accumulate of the host's traced items
+    args.set("brdf_items", to_device(rt_, compact));
+    std::vector<int2> pc(kPaths, make_int2(0, 0));
+    cl::Buffer b_pc = to_device(rt_, pc);
+    args.set("path_counts", b_pc);
+    BoundKernel ka(program_, "brdf_accumulate", args);
+    enqueue_1d(rt_.queue(), ka.bind({{"count", total}}), size_t(total));
+    Paths dev = download(args);
+    std::vector<int2> dpc = from_device<int2>(rt_, b_pc, kPaths);
+    for (int i = 0; i < total; ++i) {
+      int n = brdf_accumulate_item(i, compact.data(), total, &pb);
+      if (n > 0) pc[float_as_uint_(compact[size_t(i)].dir.w)].x += n;
+    }
+    for (int path : queue) {
+      size_t p = size_t(path);
+      int4 d = dev.brdf_state[p], h = ref.brdf_state[p];
+      ASSERT_TRUE(d.x == h.x && d.y == h.y && d.z == h.z && d.w == h.w) << "path " << path;
+      expect_close4(dev.radiance[p], ref.radiance[p], "path " + std::to_string(path) + " radiance");
+      ASSERT_EQ(dpc[p].x, pc[p].x) << "path " << path;
+    }
+    if (HasFailure()) return;
+  }
+  // Every point drew its N samples; both techniques ran and probes found emitters.
+  for (int path : queue) {
+    const int4& st = ref.brdf_state[size_t(path)];
+    ASSERT_EQ(st.z, std::max(st.y, 0)) << "path " << path;
+  }
+  EXPECT_GT(light_items, 0);
+  if (sampler_.kind == SAMPLER_BRDF_MIS) {
+    EXPECT_GT(bsdf_items, 0);
+    EXPECT_GT(bsdf_hits, 0);
+  } else {
+    EXPECT_EQ(bsdf_items, 0); // brdf-oriented: light samples only
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Samplers, KernelStages,
                          ::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive",
-                                           "tree-noorient", "tree-split-noorient"),
+                                           "tree-noorient", "tree-split-noorient", "brdf-mis",
+                                           "brdf-mis-equal", "brdf-oriented"),
                          [](const auto& p) {
                            std::string s = p.param;
                            for (char& c : s)

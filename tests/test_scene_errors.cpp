@@ -217,7 +217,7 @@ TEST(SceneErrors, MaxDepthZero) {
 TEST(SceneErrors, UnknownLightSampler) {
   EXPECT_EQ(error_of(scene_with(R"("integrator": {"light_sampler": "best"})")),
             "scene.json: integrator.light_sampler: unknown value \"best\" (expected one of: "
-            "uniform, power, tree, tree-split, exhaustive, bsdf)");
+            "uniform, power, tree, tree-split, exhaustive, bsdf, brdf-mis, brdf-oriented)");
 }
 
 TEST(SceneErrors, SplitThresholdAboveOne) {
@@ -846,8 +846,9 @@ TEST(SceneErrors, LongKeyIsTruncated) {
 
 TEST(SceneErrors, EnumValueIsEscaped) {
   std::string m = error_of(scene_with(R"("integrator": {"light_sampler": "tree\r\nsplit"})"));
-  EXPECT_EQ(m, "scene.json: integrator.light_sampler: unknown value \"tree\\r\\nsplit\" (expected "
-               "one of: uniform, power, tree, tree-split, exhaustive, bsdf)");
+  EXPECT_EQ(m,
+            "scene.json: integrator.light_sampler: unknown value \"tree\\r\\nsplit\" (expected "
+            "one of: uniform, power, tree, tree-split, exhaustive, bsdf, brdf-mis, brdf-oriented)");
 }
 
 TEST(SceneErrors, MaterialNameIsEscaped) {

@@ -48,8 +48,6 @@
 #define BRDF_MAX_BATCH 32
 // shade_f.w of a glossy point under a BRDF sampler (0 and 1: see path_state.h).
 #define BRDF_POINT_FLAG 2.0f
-// Upper bound of N_max (the scene/CLI parameter; it bounds the per-point work).
-#define BRDF_MAX_SAMPLES 1024
 
 // Samples drawn in round r: 1, 1, 2, 4, ..., BRDF_MAX_BATCH.
 INLINE int brdf_round_batch(int round) {
@@ -101,7 +99,7 @@ INLINE BrdfPoint brdf_point(const LightSamplerCtx* ls, const SceneBuffers* sc,
 
 // Probability that BRDF-oriented light sampling picks `light` at the point.
 INLINE float brdf_light_pmf(const LightSamplerCtx* ls, const BrdfPoint* bp, int light) {
-  return lt_brdf_pmf(&ls->tree, bp->cut, bp->state.x, bp->P, bp->N, &bp->lobe, light);
+  return lt_brdf_pmf(&ls->tree, bp->cut, bp->state.x, bp->P, bp->N, light);
 }
 
 // Weight of the tree light sample (density p_L) against N BRDF-aware samples drawn with share s
@@ -184,7 +182,7 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
     BrdfItem it;
     if (use_light) {
       float pmf;
-      int light = lt_brdf_pick(&ls->tree, bp.cut, bp.state.x, bp.P, bp.N, &bp.lobe, &rng, &pmf);
+      int light = lt_brdf_pick(&ls->tree, bp.cut, bp.state.x, bp.P, bp.N, &rng, &pmf);
       if (light < 0) continue;
       float u1 = lt_rng_next(&rng), u2 = lt_rng_next(&rng);
       LightPoint lp;
@@ -202,7 +200,10 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
       it.value = f4_from3(c, 0.0f);
       it.extra = make_float4(lp.bsdf_pdf, p_i, (float)BRDF_ITEM_LIGHT, 0.0f);
     } else {
-      float3 u = make_float3(lt_rng_next(&rng), lt_rng_next(&rng), lt_rng_next(&rng));
+      // One declarator each: the order of a call's arguments is unspecified (host and device
+      // compilers differ), that of declarators is not.
+      float u1 = lt_rng_next(&rng), u2 = lt_rng_next(&rng), u3 = lt_rng_next(&rng);
+      float3 u = make_float3(u1, u2, u3);
       BsdfSample bs = bsdf_sample(&bp.m, bp.wo_local, u);
       float3 wi = normalize(frame_to_world(&bp.fr, bs.wi));
       // Absorbed, delta or into the geometric surface: a probe that finds nothing (a miss for

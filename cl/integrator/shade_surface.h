@@ -40,7 +40,11 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
                                const PathBuffers* pb, const LightSamplerCtx* ls) {
   int2 out = make_int2(0, 0);
   Hit h = pb->hits[path];
-  if (h.prim < 0) return out; // escaped: no environment light
+  if (h.prim < 0) { // escaped: no environment light
+    // and no glossy point: brdf_sample must not act on a stale (or never written) brdf_state
+    if (HAS_MICROFACET && light_sampler_brdf(ls)) pb->brdf_state[path] = make_int4(0, 0, 0, 0);
+    return out;
+  }
   float3 d = xyz_of(pb->ray_d[path]);
   GLOBAL const Primitive* prim = &sc->prims[h.prim];
   float3 P_err;
