@@ -1,20 +1,33 @@
 #!/usr/bin/env bash
 # Regenerates docs/results.md and everything in docs/results/ from scratch: builds canopy, renders
 # a reference per scene, runs `canopy converge` for every sampler configuration, renders the heat
-# maps, and writes the report (scripts/results-report.py). About 25 minutes on 2 cores; not run
+# maps, and writes the report (scripts/results-report.py). About 45 minutes on 2 cores; not run
 # by CI. Timings are only meaningful on an otherwise idle machine.
+#
+# Besides the scene files, SCENES may name two steps of issue 12 (BRDF-oriented many-light
+# sampling, Liu, Xu & Yan 2019):
+#   default      scenes/default.json (diffuse only): tree-split against brdf-mis at equal time
+#                (without a glossy material brdf-mis renders as tree-split: its overhead must be nil)
+#   scalability  glossy-cornell regenerated with 10^3, 10^4, 10^5 lights (their Fig. 10): render
+#                seconds per spp of brdf-mis (and tree-split), SCALE_REPS repetitions each
 #
 #   ./scripts/make-results.sh                 # everything
 #   SCENES="spiral-10k city" ./scripts/make-results.sh   # a subset (the report covers what exists)
-#   SCENES="glossy-cornell showroom" ./scripts/make-results.sh   # the glossy scenes (issue 11)
+#   SCENES="glossy-cornell showroom" ./scripts/make-results.sh   # the glossy scenes (issues 11-12)
+#   SCENES="glossy-cornell showroom default scalability" ./scripts/make-results.sh   # issue 12
 #   CANOPY=path/to/canopy SKIP_BUILD=1 ./scripts/make-results.sh
 #   # A dry run of the machinery (meaningless numbers, nothing under docs/ touched):
 #   BUDGET=1 REF_SPP=16 SEEDS=1 DOCS=/tmp/r REPORT=/tmp/r.md SCENES=plane-10k ./scripts/make-results.sh
+#   BUDGET=1 REF_SPP=16 SEEDS=1 SCALE_COUNTS="1000 4000" SCALE_SPP=1 SCALE_REPS=1 DOCS=/tmp/r \
+#     REPORT=/tmp/r.md SCENES="glossy-cornell default scalability" ./scripts/make-results.sh
 #
 # Environment: SCENES, BUILD, CANOPY, SKIP_BUILD; BUDGET and REF_SPP override every scene's budget
 # and reference spp; SEEDS (3); WORK (out/results), DOCS (docs/results) and REPORT
-# (docs/results.md) move the outputs; SAMPLERS_MANY and SAMPLERS_GLOSSY replace the two sampler
-# sets.
+# (docs/results.md) move the outputs; SAMPLERS_MANY, SAMPLERS_GLOSSY and SAMPLERS_DIFFUSE replace
+# the sampler sets; REUSE_REFERENCE=1 keeps a reference already in $WORK (same scene, film scale
+# and reference sampler: the caller's responsibility) instead of rendering it again. Scalability:
+# SCALE_COUNTS (light counts, "1000 10000 100000"), SCALE_SPP (8), SCALE_REPS (3), SCALE_FILM
+# (film scale, 0.5 = 128 x 128), SCALE_SAMPLERS ("brdf-mis,tree-split").
 #
 # References and other large intermediates go to $WORK (not committed); $DOCS gets the CSVs and
 # the small PNGs.
@@ -35,16 +48,27 @@ mkdir -p "$WORK" "$DOCS"
 # Two sampler sets. "many": the many-light scenes of issues 5 and 10 (light samplers, split
 # thresholds, the orientation ablation). "glossy": the glossy scenes of issue 11, the baseline of
 # issue 12: tree-split at the scene's (default) threshold against power and BSDF-only sampling,
-# each light sampler with MIS and without (/nomis; bsdf has no light samples, so no MIS variant).
+# each light sampler with MIS and without (/nomis; bsdf has no light samples, so no MIS variant);
+# and for issue 12 the BRDF-oriented samplers of Liu et al. 2019: brdf-mis (three-technique MIS,
+# adaptive allocation, delta 0.5), brdf-oriented alone, brdf-mis/equal (equal allocation, their
+# Fig. 8) and brdf-mis:D, the sweep of the cut's split threshold delta (their Table 2).
+# "diffuse": the default scene, where brdf-mis must cost nothing over tree-split.
 SAMPLERS_MANY=${SAMPLERS_MANY:-uniform,power,tree,tree-noorient,tree-split:0.0,tree-split:0.25,tree-split:0.5,tree-split:0.85,tree-split:0.95}
-SAMPLERS_GLOSSY=${SAMPLERS_GLOSSY:-tree-split,tree-split/nomis,power,power/nomis,bsdf}
+SAMPLERS_GLOSSY=${SAMPLERS_GLOSSY:-tree-split,tree-split/nomis,power,power/nomis,bsdf,brdf-mis,brdf-oriented,brdf-mis/equal,brdf-mis:0.005,brdf-mis:0.05,brdf-mis:0.1,brdf-mis:0.3,brdf-mis:0.7}
+SAMPLERS_DIFFUSE=${SAMPLERS_DIFFUSE:-tree-split,brdf-mis}
+SCALE_COUNTS=${SCALE_COUNTS:-"1000 10000 100000"}
+SCALE_SPP=${SCALE_SPP:-8}
+SCALE_REPS=${SCALE_REPS:-3}
+SCALE_FILM=${SCALE_FILM:-0.5}
+SCALE_SAMPLERS=${SCALE_SAMPLERS:-brdf-mis,tree-split}
 SEEDS=${SEEDS:-3}
 # Clamping (--clamp) biases heavy-tailed estimators (uniform sampling of the spiral, whose error
 # would then grow with spp), so only cornell-1m clamps: its 10^6 sub-pixel ceiling lights are in
 # view, and their anti-aliasing noise, which no light sampler changes, would otherwise dominate
 # the RMSE. The other scenes keep emitters out of sight (points, spots; mesh-light's ring is just
 # above the frame). glossy-cornell clamps for the same reason as cornell-1m (10^4 sub-pixel
-# spheres on the side walls, in view); the showroom's lights are all above the frame.
+# spheres on the side walls, in view); the showroom's lights are all above the frame. The default
+# scene's 256 small ceiling quads are in view too (a few pixels each), so it clamps as well.
 
 # The reference sampler is the most efficient one measured for the scene (any unbiased sampler
 # converges to the same image; its seeds differ from the curves').
@@ -62,14 +86,41 @@ mesh-light     | 0.75 | 20 | tree       | 768  | 0 | many
 plane-10k      | 1    | 20 | tree       | 1024 | 0 | many
 glossy-cornell | 0.5  | 20 | power      | 2048 | 1 | glossy
 showroom       | 0.5  | 20 | tree-split | 1024 | 0 | glossy
+default        | 0.5  | 20 | tree-split | 1024 | 1 | diffuse
 "
-SCENES=${SCENES:-"spiral-10k cornell-1m city mesh-light plane-10k glossy-cornell showroom"}
+SCENES=${SCENES:-"spiral-10k cornell-1m city mesh-light plane-10k glossy-cornell showroom default scalability"}
 
 has_heatmap=0
 if "$CANOPY" render --help 2>/dev/null | grep -q -- "--heatmap"; then has_heatmap=1; fi
 
+# Fig. 10 of Liu et al.: render time against the light count. glossy-cornell is regenerated with
+# each count (same generator and seed as the committed scene; the total power is fixed, so only
+# the noise changes). `canopy converge` measures the render seconds (after its unrecorded warm-up
+# render, so kernel compilation is excluded) of SCALE_REPS renders at SCALE_SPP spp; its reference
+# is a throw-away 2-spp image (the RMSE is not used here).
+scalability() {
+  local n scene
+  for n in $SCALE_COUNTS; do
+    scene=$WORK/glossy-cornell-$n.json
+    python3 scripts/gen-glossy-cornell.py --count "$n" --no-mesh --out "$scene" >&2
+    echo "== scalability: $n lights, $SCALE_SPP spp x $SCALE_REPS, $SCALE_SAMPLERS" >&2
+    "$CANOPY" converge "$scene" --film-scale "$SCALE_FILM" --reference "$WORK/scale-$n-ref.exr" \
+      --reference-sampler power --reference-spp 2 --samplers "$SCALE_SAMPLERS" \
+      --spp-start "$SCALE_SPP" --max-spp "$SCALE_SPP" --budget 100000 --seeds "$SCALE_REPS" \
+      --out "$WORK/scale-$n" | tee "$WORK/scale-$n-converge.txt"
+    cp "$WORK/scale-$n.csv" "$DOCS/scalability-$n.csv"
+    cp "$WORK/scale-$n-configs.csv" "$DOCS/scalability-$n-configs.csv"
+  done
+}
+
 start=$(date +%s)
 for name in $SCENES; do
+  if [ "$name" = scalability ]; then
+    rm -f "$DOCS"/scalability-*.csv
+    scalability
+    echo "== scalability done, $(( $(date +%s) - start )) s so far" >&2
+    continue
+  fi
   row=$(echo "$SCENE_TABLE" | awk -F'|' -v OFS='|' -v n="$name" '{gsub(/ /, "", $1)} $1 == n')
   if [ -z "$row" ]; then echo "make-results: unknown scene $name" >&2; exit 2; fi
   IFS='|' read -r _ scale budget ref_sampler ref_spp clamp set <<<"$(echo "$row" | tr -d ' ')"
@@ -78,6 +129,7 @@ for name in $SCENES; do
   case "$set" in
     many) samplers=$SAMPLERS_MANY ;;
     glossy) samplers=$SAMPLERS_GLOSSY ;;
+    diffuse) samplers=$SAMPLERS_DIFFUSE ;;
     *) echo "make-results: scene $name: unknown sampler set '$set'" >&2; exit 2 ;;
   esac
   clamp_opt=()
@@ -87,12 +139,16 @@ for name in $SCENES; do
     echo "make-results: $scene does not exist, skipped" >&2
     continue
   fi
+  ref_opt=(--reference-sampler "$ref_sampler" --reference-spp "$ref_spp")
+  if [ -n "${REUSE_REFERENCE:-}" ] && [ -f "$WORK/$name-ref.exr" ]; then
+    ref_opt=()
+    echo "== $name: reusing the reference $WORK/$name-ref.exr" >&2
+  fi
   echo "== $name: reference $ref_sampler x $ref_spp spp, film scale $scale, budget $budget s," \
     "samplers $samplers" >&2
   "$CANOPY" converge "$scene" --film-scale "$scale" "${clamp_opt[@]}" \
-    --reference "$WORK/$name-ref.exr" --reference-sampler "$ref_sampler" \
-    --reference-spp "$ref_spp" --samplers "$samplers" --budget "$budget" --seeds "$SEEDS" \
-    --out "$DOCS/$name" | tee "$WORK/$name-converge.txt"
+    --reference "$WORK/$name-ref.exr" "${ref_opt[@]}" --samplers "$samplers" \
+    --budget "$budget" --seeds "$SEEDS" --out "$DOCS/$name" | tee "$WORK/$name-converge.txt"
   # The reference's metadata, for the report.
   "$CANOPY" compare "$WORK/$name-ref.exr" "$WORK/$name-ref.exr" --json >"$DOCS/$name-reference.json"
   cp "$WORK/$name-ref.png" "$DOCS/$name.png"
@@ -105,7 +161,16 @@ for name in $SCENES; do
   echo "== $name done, $(( $(date +%s) - start )) s so far" >&2
 done
 
+# A line on this run for the report: what was regenerated, and with which budgets.
+note="Last run ($(date -u '+%Y-%m-%d %H:%M') UTC): \`SCENES=\"$SCENES\"\`, render budget"
+note+=" ${BUDGET:-of the scene table (make-results.sh)} s per configuration, $SEEDS seeds per"
+note+=" point, reference spp ${REF_SPP:-of the scene table}"
+case " $SCENES " in
+  *" scalability "*) note+="; scalability: $SCALE_SPP spp x $SCALE_REPS renders at film scale $SCALE_FILM" ;;
+esac
+note+=". Sections of scenes not in SCENES come from the CSVs of an earlier run (their own seeds"
+note+=" and budgets)."
 python3 scripts/results-report.py --docs "$DOCS" --command "./scripts/make-results.sh" \
-  --seeds "$SEEDS" >"$REPORT.tmp"
+  --seeds "$SEEDS" --note "$note" >"$REPORT.tmp"
 mv "$REPORT.tmp" "$REPORT"
 echo "wrote $REPORT ($(( $(date +%s) - start )) s)" >&2

@@ -6,7 +6,10 @@ Run by scripts/make-results.sh; standard library only.
 Two groups of scenes: the many-light scenes of issues 5 and 10 (SCENES: light samplers and split
 thresholds, the targets and the paper's claims) and the glossy scenes of issue 11 (GLOSSY_SCENES:
 tree-split, power and BSDF-only sampling, each light sampler with and without MIS; the baseline of
-issue 12). A group's summary covers only its own scenes.
+issue 12). A group's summary covers only its own scenes. Issue 12 (BRDF-oriented many-light
+sampling, Liu, Xu & Yan 2019) adds the brdf-* configurations on the glossy scenes, the diffuse
+default scene (DIFFUSE_SCENES: tree-split against brdf-mis) and the scalability runs
+(scalability-<lights>.csv: render seconds of a fixed spp against the light count).
 
 Equal-time error: each configuration's median curve (RMSE against render seconds) is interpolated
 in log-log; outside its measured range it is extended with the Monte Carlo rate RMSE ~ t^-1/2 from
@@ -43,6 +46,25 @@ GLOSSY_SCENES = [
 GLOSSY_TREE = "tree-split"
 GLOSSY_LIGHT_SAMPLERS = ["tree-split", "power"]
 NOMIS = "/nomis"
+# Issue 12: the diffuse default scene, where brdf-mis must cost nothing over tree-split.
+DIFFUSE_SCENES = [
+    ("default", "Canopy's default scene: a diffuse Cornell box lit by 256 small ceiling quads "
+                "(no glossy material: brdf-mis renders as tree-split there)"),
+]
+# Labels of the BRDF-oriented configurations (make-results.sh SAMPLERS_GLOSSY): brdf-mis has
+# delta 0.5 (LT_BRDF_DEFAULT_DELTA), N_max 50 and lambda 10 (the paper's settings), adaptive
+# allocation; brdf-mis:D sweeps delta (Table 2).
+BRDF_MIS = "brdf-mis"
+BRDF_ORIENTED = "brdf-oriented"
+BRDF_EQUAL = "brdf-mis/equal"
+BRDF_DEFAULT_DELTA = 0.5
+# Issue 12's targets (equal-time RMSE ratios, render-time ratio).
+TARGET_GLOSSY = 0.8
+TARGET_SCALE = 1.5
+PAPER_SCALE = 20.0 / 11.0  # Fig. 10: 11 s -> 20 s from 10^3 to 10^5 lights
+TARGET_DIFFUSE = 1.05
+# A ratio within this of 1 is not a difference: the seed-to-seed noise of the medians (as above).
+NOISE_MARGIN = 0.05
 # The default split threshold (LT_DEFAULT_SPLIT_THRESHOLD in cl/light_tree/split.h).
 DEFAULT_THRESHOLD = "tree-split:0.25"
 THRESHOLDS = ["tree-split:0.0", "tree-split:0.25", "tree-split:0.5", "tree-split:0.85", "tree-split:0.95"]
@@ -145,6 +167,26 @@ class Scene:
         t, r, _, _ = pts[-1]
         return r * r * t
 
+    def seeds(self):
+        return len({r["seed"] for r in self.runs})
+
+    def brdf_means(self, label):
+        """(mean BRDF-oriented cut size, mean BRDF-aware samples) per glossy point over every
+        render of the configuration (Liu et al.'s Table 1-2 columns); None before issue 12's
+        columns or without glossy points."""
+        rows = [r for r in self.runs if r["sampler"] == label and "glossy_points" in r]
+        pts = sum(int(r["glossy_points"]) for r in rows)
+        if not pts:
+            return None
+        return (sum(int(r["brdf_cut_sum"]) for r in rows) / pts,
+                sum(int(r["brdf_samples_sum"]) for r in rows) / pts)
+
+    def seconds_per_spp(self, label):
+        """Median render seconds per sample per pixel at the curve's last (highest-spp) point,
+        where fixed per-render costs weigh least."""
+        pts = self.curves.get(label, [])
+        return pts[-1][0] / pts[-1][3] if pts else math.nan
+
     def best_split(self):
         cands = [l for l in THRESHOLDS if l in self.eq]
         return min(cands, key=lambda l: self.eq[l][0]) if cands else None
@@ -220,7 +262,8 @@ def scene_section(s, clamp, seeds, docs, glossy=False):
     else:
         out.append("Heat map: not produced (this build of `canopy render` has no `--heatmap`).\n")
     out.append(f"Data: [`{s.name}.csv`](results/{s.name}.csv) (every render), "
-               f"[`{s.name}-median.csv`](results/{s.name}-median.csv) (medians of {seeds} seeds), "
+               f"[`{s.name}-median.csv`](results/{s.name}-median.csv) (medians of {s.seeds()} "
+               f"seeds), "
                f"[`{s.name}-configs.csv`](results/{s.name}-configs.csv) (build and compile "
                f"times).\n")
     return "\n".join(out)
@@ -295,12 +338,330 @@ def glossy_summary(glossy):
     return "\n".join(o)
 
 
+def met(ok):
+    return "MET" if ok else "NOT MET"
+
+
+def delta_of(label):
+    """The BRDF split threshold delta of a brdf-mis configuration label, or None."""
+    if label == BRDF_MIS:
+        return BRDF_DEFAULT_DELTA
+    if label.startswith(BRDF_MIS + ":") and "/" not in label:
+        try:
+            return float(label.split(":", 1)[1])
+        except ValueError:
+            return None
+    return None
+
+
+def read_scalability(docs):
+    """{lights: {sampler: {"sec_per_spp": median over the repetitions, "reps": n, "spp": spp,
+    "cut": ..., "samples": ..., "tree_build": s}}} from scalability-<lights>.csv."""
+    out = {}
+    for f in sorted(os.listdir(docs)) if os.path.isdir(docs) else []:
+        if not (f.startswith("scalability-") and f.endswith(".csv")) or f.endswith("-configs.csv"):
+            continue
+        try:
+            n = int(f[len("scalability-"):-len(".csv")])
+        except ValueError:
+            continue
+        rows = read_csv(os.path.join(docs, f))
+        cfg_path = os.path.join(docs, f"scalability-{n}-configs.csv")
+        cfgs = {c["sampler"]: c for c in read_csv(cfg_path)} if os.path.exists(cfg_path) else {}
+        per = {}
+        for label in dict.fromkeys(r["sampler"] for r in rows):
+            rr = [r for r in rows if r["sampler"] == label]
+            secs = sorted(float(r["seconds"]) / int(r["spp"]) for r in rr)
+            med = secs[len(secs) // 2] if len(secs) % 2 else 0.5 * (secs[len(secs) // 2 - 1] +
+                                                                      secs[len(secs) // 2])
+            pts = sum(int(r.get("glossy_points") or 0) for r in rr)
+            per[label] = {
+                "sec_per_spp": med, "reps": len(rr), "spp": int(rr[0]["spp"]),
+                "cut": sum(int(r["brdf_cut_sum"]) for r in rr) / pts if pts else None,
+                "samples": sum(int(r["brdf_samples_sum"]) for r in rr) / pts if pts else None,
+                "tree_build": float(cfgs[label]["light_tree_seconds"]) if label in cfgs else None,
+            }
+        out[n] = per
+    return out
+
+
+def brdf_section(glossy, diffuse, scal, docs):
+    """Issue 12: BRDF-oriented many-light sampling (Liu, Xu & Yan 2019) against the issue-11
+    baseline, its delta sweep, allocation ablation, scalability, overhead on a diffuse scene, and
+    the paper's claims. Every number comes from the CSVs."""
+    o = ["## BRDF-oriented many-light sampling (issue 12)\n"]
+    o.append(
+        "Liu, Xu & Yan 2019, *Adaptive BRDF-oriented multiple importance sampling of many "
+        "lights*. At a glossy shading point `brdf-oriented` selects a light cut by the BRDF's "
+        "cap integral S_C (split a cluster while S_C > δ, their Eq. 5) and samples it by S_C; "
+        "`brdf-mis` combines three techniques with MIS: tree light sampling with splitting "
+        "([EK18], Canopy's `tree-split`), BRDF-oriented light sampling and BSDF sampling, "
+        "with N = ⌈N_max I_B⌉ BRDF-aware samples (N_max 50, their Eq. 8-9) allocated "
+        "adaptively between the last two (λ = 10, their Alg. 1); `brdf-mis/equal` allocates "
+        "one sample to each (their Fig. 8 ablation); `brdf-mis:D` sets δ = D (default 0.5). "
+        "Diffuse points use `tree-split` in every brdf-* configuration. Same method as above: "
+        "equal render time per image (the scene's equal time, the longest time every curve of "
+        "the scene reaches, * = extended with t^-1/2), medians of the seeds. Cut size and "
+        "samples are means over glossy shading points of every render of the configuration "
+        "(the paper's Table 1-2 columns).\n")
+    if not glossy:
+        o.append("Not run (neither glossy scene was rendered).\n")
+    claims = []
+
+    # (i) the samplers against the baseline
+    o.append("### Equal-time error against the baseline\n")
+    o.append("| scene | configuration | RMSE | vs tree-split [EK18] | MSE × time (s) "
+             "| s per spp | cut / glossy point | BRDF-aware samples / glossy point |")
+    o.append("|---|---|---|---|---|---|---|---|")
+    target_rows = []
+    for name, _ in GLOSSY_SCENES:
+        sc = glossy.get(name)
+        if not sc:
+            o.append(f"| {name} | | not run | | | | | |")
+            continue
+        for label in (BRDF_MIS, BRDF_ORIENTED, BRDF_EQUAL, GLOSSY_TREE, GLOSSY_TREE + NOMIS, "bsdf",
+                      "power"):
+            if label not in sc.eq:
+                o.append(f"| {name} | {label} | not run | | | | | |")
+                continue
+            r, ex = sc.eq[label]
+            bm = sc.brdf_means(label)
+            o.append(f"| {name} | {label} | {fmt_e(r)}{'*' if ex else ''} | "
+                     f"{fmt_r(sc.ratio(label, GLOSSY_TREE))} | {fmt_e(sc.mse_time(label))} | "
+                     f"{sc.seconds_per_spp(label):.3f} | "
+                     f"{f'{bm[0]:.2f}' if bm else 'n/a'} | {f'{bm[1]:.2f}' if bm else 'n/a'} |")
+        if BRDF_MIS in sc.eq and GLOSSY_TREE in sc.eq:
+            target_rows.append((name, sc.ratio(BRDF_MIS, GLOSSY_TREE), sc.t_eq))
+    o.append("")
+    ok = len(target_rows) == len(GLOSSY_SCENES) and all(r <= TARGET_GLOSSY for _, r, _ in target_rows)
+    o.append(f"**Target: brdf-mis ≤ {TARGET_GLOSSY} × tree-split at equal time on both glossy "
+             f"scenes: {met(ok)}** (" + (
+                 "; ".join(f"{n}: {r:.2f}× at {t:.3g} s" for n, r, t in target_rows)
+                 if target_rows else "not measured") +
+             (")." if len(target_rows) == len(GLOSSY_SCENES) else "; a scene is missing).") + "\n")
+
+    # (ii) the delta sweep
+    o.append("### The split threshold δ (the paper's Table 2)\n")
+    o.append("| scene | δ | cut / glossy point | BRDF-aware samples / glossy point | RMSE "
+             "| vs δ = 0.5 | s per spp |")
+    o.append("|---|---|---|---|---|---|---|")
+    sweeps = {}
+    for name, _ in GLOSSY_SCENES:
+        sc = glossy.get(name)
+        if not sc:
+            continue
+        rows = sorted((delta_of(l), l) for l in sc.labels if delta_of(l) is not None)
+        sweeps[name] = []
+        for d, l in rows:
+            bm = sc.brdf_means(l)
+            r, ex = sc.eq[l]
+            sweeps[name].append((d, bm, r, sc.seconds_per_spp(l)))
+            o.append(f"| {name} | {d:g} | {f'{bm[0]:.2f}' if bm else 'n/a'} | "
+                     f"{f'{bm[1]:.2f}' if bm else 'n/a'} | {fmt_e(r)}{'*' if ex else ''} | "
+                     f"{fmt_r(sc.ratio(l, BRDF_MIS)) if BRDF_MIS in sc.eq else 'n/a'} | "
+                     f"{sc.seconds_per_spp(l):.3f} |")
+    o.append("")
+    best_txt = []
+    for name, rows in sweeps.items():
+        if rows:
+            bd = min(rows, key=lambda x: x[2])
+            best_txt.append(f"{name}: lowest equal-time RMSE at δ = {bd[0]:g}")
+    if best_txt:
+        o.append("; ".join(best_txt) + " (the paper chooses 0.5 as its trade-off).\n")
+
+    # (iii) equal against adaptive allocation
+    o.append("### Equal against adaptive allocation (the paper's Fig. 8)\n")
+    o.append("| scene | RMSE adaptive (brdf-mis) | RMSE equal (brdf-mis/equal) | equal / adaptive "
+             "| samples / glossy point, adaptive | equal | s per spp, adaptive | equal |")
+    o.append("|---|---|---|---|---|---|---|---|")
+    alloc = []
+    for name, _ in GLOSSY_SCENES:
+        sc = glossy.get(name)
+        if not sc or BRDF_MIS not in sc.eq or BRDF_EQUAL not in sc.eq:
+            o.append(f"| {name} | not run | | | | | | |")
+            continue
+        ra, rq = sc.eq[BRDF_MIS][0], sc.eq[BRDF_EQUAL][0]
+        ba, bq = sc.brdf_means(BRDF_MIS), sc.brdf_means(BRDF_EQUAL)
+        alloc.append((name, rq / ra))
+        o.append(f"| {name} | {fmt_e(ra)} | {fmt_e(rq)} | {rq / ra:.2f}× | "
+                 f"{f'{ba[1]:.2f}' if ba else 'n/a'} | {f'{bq[1]:.2f}' if bq else 'n/a'} | "
+                 f"{sc.seconds_per_spp(BRDF_MIS):.3f} | {sc.seconds_per_spp(BRDF_EQUAL):.3f} |")
+    o.append("")
+
+    # (iv) scalability
+    o.append("### Scalability with the light count (the paper's Fig. 10)\n")
+    scale_ok = scale_ratio = None
+    if scal:
+        counts = sorted(scal)
+        samplers = list(dict.fromkeys(l for n in counts for l in scal[n]))
+        any_n = scal[counts[0]]
+        first = next(iter(any_n.values()))
+        o.append(f"glossy-cornell regenerated with each light count (`scripts/gen-glossy-cornell.py "
+                 f"--count N`, same seed and total power), {first['spp']} spp per render, the "
+                 f"median of {first['reps']} renders (after an unrecorded warm-up render).\n")
+        o.append("| lights | " + " | ".join(f"{l}: s per spp" for l in samplers) +
+                 " | brdf-mis: cut / glossy point | brdf-mis: samples / glossy point "
+                 "| light tree build (s) |")
+        o.append("|---|" + "---|" * len(samplers) + "---|---|---|")
+        for n in counts:
+            cells = [f"{scal[n][l]['sec_per_spp']:.3f}" if l in scal[n] else "n/a"
+                     for l in samplers]
+            b = scal[n].get(BRDF_MIS, {})
+
+            def num(v, f="{:.2f}"):
+                return "n/a" if v is None else f.format(v)
+
+            o.append(f"| {n:,} | " + " | ".join(cells) + f" | {num(b.get('cut'))} | "
+                     f"{num(b.get('samples'))} | {num(b.get('tree_build'), '{:.3f}')} |")
+        o.append("")
+        lo, hi = counts[0], counts[-1]
+        if BRDF_MIS in scal[lo] and BRDF_MIS in scal[hi] and hi > lo:
+            ratio = scal[hi][BRDF_MIS]["sec_per_spp"] / scal[lo][BRDF_MIS]["sec_per_spp"]
+            scale_ok, scale_ratio = ratio <= TARGET_SCALE, ratio
+            o.append(f"**Target: brdf-mis render time per sample at {hi:,} lights ≤ {TARGET_SCALE} × "
+                     f"at {lo:,}: {met(scale_ok)}** ({hi:,} / {lo:,}: {ratio:.2f}×; the paper: "
+                     f"11 s → 20 s, 1.8×, from 1,000 to 100,000 lights).\n")
+            scale_txt = f"brdf-mis s per spp {lo:,} → {hi:,} lights: {ratio:.2f}×"
+            if GLOSSY_TREE in scal[lo] and GLOSSY_TREE in scal[hi]:
+                rt = scal[hi][GLOSSY_TREE]["sec_per_spp"] / scal[lo][GLOSSY_TREE]["sec_per_spp"]
+                scale_txt += f" (tree-split {rt:.2f}×)"
+                o.append(f"tree-split, for comparison: {rt:.2f}× over the same range.\n")
+        else:
+            scale_txt = "brdf-mis not measured at both ends"
+            o.append("**Target: ≤ 1.5× from 10^3 to 10^5 lights: NOT MET** (not measured at both "
+                     "ends).\n")
+    else:
+        scale_txt = "not run"
+        o.append("Not run.\n")
+
+    # (v) the diffuse default scene
+    o.append("### Overhead on a diffuse scene\n")
+    dsc = diffuse.get("default")
+    diffuse_ratio = None
+    if dsc and BRDF_MIS in dsc.eq and GLOSSY_TREE in dsc.eq:
+        diffuse_ratio = dsc.ratio(BRDF_MIS, GLOSSY_TREE)
+        o.append(f"[default](#default) (no glossy material): equal-time RMSE at {dsc.t_eq:.3g} s, "
+                 f"tree-split {fmt_e(dsc.eq[GLOSSY_TREE][0])}, brdf-mis "
+                 f"{fmt_e(dsc.eq[BRDF_MIS][0])}; s per spp tree-split "
+                 f"{dsc.seconds_per_spp(GLOSSY_TREE):.3f}, brdf-mis "
+                 f"{dsc.seconds_per_spp(BRDF_MIS):.3f}.\n")
+        o.append(f"**Target: brdf-mis ≤ {TARGET_DIFFUSE} × tree-split at equal time: "
+                 f"{met(diffuse_ratio <= TARGET_DIFFUSE)}** ({diffuse_ratio:.2f}×).\n")
+    else:
+        o.append("Not run.\n")
+
+    # (vi) the paper's claims
+    def ratio_txt(sc, a, b):
+        return f"{a}/{b} {sc.ratio(a, b):.2f}×"
+
+    # 1. BRDF-oriented sampling beats tree light sampling on glossy scenes.
+    txt, oks = [], []
+    for name, sc in glossy.items():
+        if BRDF_MIS in sc.eq and GLOSSY_TREE in sc.eq:
+            r = sc.ratio(BRDF_MIS, GLOSSY_TREE)
+            oks.append(r < 1 - NOISE_MARGIN)
+            txt.append(f"{name}: {ratio_txt(sc, BRDF_MIS, GLOSSY_TREE)}")
+            if BRDF_ORIENTED in sc.eq:
+                txt[-1] += f", {ratio_txt(sc, BRDF_ORIENTED, GLOSSY_TREE)}"
+    claims.append(("BRDF-oriented MIS beats tree light sampling [EK18] on glossy scenes at equal "
+                   "time (Fig. 1, 11-14)", "; ".join(txt) or "not run", verdict(oks)))
+    # 2. brdf-oriented alone beats each traditional technique and their MIS on the Cornell box.
+    gc = glossy.get("glossy-cornell")
+    if gc and BRDF_ORIENTED in gc.eq:
+        others = [l for l in (GLOSSY_TREE + NOMIS, "bsdf", GLOSSY_TREE) if l in gc.eq]
+        rs = [(l, gc.ratio(BRDF_ORIENTED, l)) for l in others]
+        oks = [r < 1 - NOISE_MARGIN for _, r in rs]
+        extra = ""
+        if BRDF_MIS in gc.eq:
+            extra = (f"; brdf-mis/brdf-oriented {gc.ratio(BRDF_MIS, BRDF_ORIENTED):.2f}× (the "
+                     f"paper expects brdf-mis slightly worse than brdf-oriented here)")
+        claims.append(("On the Cornell box, BRDF-oriented light sampling alone beats light "
+                       "sampling alone, BSDF sampling alone and their MIS [EK18] (Fig. 14: "
+                       "tree-split/nomis, bsdf, tree-split)",
+                       "glossy-cornell: " + ", ".join(f"brdf-oriented/{l} {r:.2f}×" for l, r in rs)
+                       + extra, verdict(oks if len(rs) == 3 else oks + [False])))
+    else:
+        claims.append(("On the Cornell box, BRDF-oriented light sampling alone beats each "
+                       "traditional technique and their MIS (Fig. 14)", "not run", "not measured"))
+    # 3. MIS makes it robust: never worse than [EK18] (tree-split), on glossy and diffuse scenes
+    # alike (the paper's Fig. 13: "slightly better ... consistently robust" on a scene with few
+    # lights); the ratio to the best single technique it combines is given for information.
+    txt, oks = [], []
+    for name, sc in glossy.items():
+        if BRDF_MIS not in sc.eq or GLOSSY_TREE not in sc.eq:
+            continue
+        r = sc.ratio(BRDF_MIS, GLOSSY_TREE)
+        oks.append(r <= 1 + NOISE_MARGIN)
+        t = f"{name}: brdf-mis/tree-split {r:.2f}×"
+        cands = [l for l in (GLOSSY_TREE, BRDF_ORIENTED, "bsdf") if l in sc.eq]
+        best = min(cands, key=lambda l: sc.eq[l][0])
+        t += f" (/ the best single technique, {best}, {sc.ratio(BRDF_MIS, best):.2f}×)"
+        txt.append(t)
+    if diffuse_ratio is not None:
+        txt.append(f"default (diffuse): brdf-mis/tree-split {diffuse_ratio:.2f}×")
+        oks.append(diffuse_ratio <= 1 + NOISE_MARGIN)
+    claims.append(("MIS of the three techniques makes the method robust: never worse than "
+                   f"[EK18] (tree-split; within {NOISE_MARGIN:.0%}) on any scene, glossy or not "
+                   "(Fig. 13)", "; ".join(txt) or "not run", verdict(oks)))
+    # 4. Adaptive beats equal allocation.
+    claims.append(("Adaptive allocation beats equal allocation at equal time (Fig. 8, 11)",
+                   "; ".join(f"{n}: equal/adaptive {r:.2f}×" for n, r in alloc) or "not run",
+                   verdict([r > 1 + NOISE_MARGIN for _, r in alloc])))
+    # 5. Larger delta: smaller cuts, more samples.
+    txt, oks = [], []
+    for name, rows in sweeps.items():
+        rows = [x for x in rows if x[1]]
+        if len(rows) < 2:
+            continue
+        cuts = [x[1][0] for x in rows]
+        smp = [x[1][1] for x in rows]
+        dec = all(b <= a for a, b in zip(cuts, cuts[1:]))
+        inc = all(b >= a for a, b in zip(smp, smp[1:]))
+        oks.append(dec and inc)
+        txt.append(f"{name}: δ " + ", ".join(f"{x[0]:g}" for x in rows) + " → cut " +
+                   ", ".join(f"{c:.1f}" for c in cuts) + "; samples " +
+                   ", ".join(f"{v:.1f}" for v in smp) +
+                   f" (cut {'non-increasing' if dec else 'not monotone'}, samples "
+                   f"{'non-decreasing' if inc else 'not monotone'})")
+    claims.append(("A larger δ gives smaller cuts and more BRDF-aware samples (Table 2)",
+                   "; ".join(txt) or "not run", verdict(oks)))
+    # 6. Scalability.
+    # Reproduced: growth no steeper than the paper's 1.8x (within the noise margin); the issue's
+    # own target (TARGET_SCALE) is stricter and reported above.
+    claims.append(("Render time grows slowly with the light count: 1.8× from 10^3 to 10^5 lights "
+                   "(Fig. 10)", scale_txt,
+                   "not measured" if scale_ratio is None else
+                   ("reproduced" if scale_ratio <= PAPER_SCALE * (1 + NOISE_MARGIN)
+                    else "not reproduced")))
+    o.append("### The paper's claims (issue 12)\n")
+    o.append("“Reproduced” needs the effect beyond the seed-to-seed noise of the medians "
+             f"({NOISE_MARGIN:.0%}) on every scene measured; “partly” means on some.\n")
+    o.append("| claim | measured | verdict |")
+    o.append("|---|---|---|")
+    for c in claims:
+        o.append("| " + " | ".join(c) + " |")
+    o.append("")
+    o.append(
+        "Caveats: the paper renders direct illumination only, Canopy's scenes have 2-3 bounces "
+        "(max depth 3), so indirect light, which every configuration samples the same way, "
+        "dilutes the differences; the scenes are stand-ins for theirs (see the caveats above); "
+        "the cap integral S_C is Canopy's fit (docs/cap-integral.md), not the paper's table.\n")
+    return "\n".join(o)
+
+
+def verdict(oks):
+    if not oks:
+        return "not measured"
+    return "reproduced" if all(oks) else ("partly" if any(oks) else "not reproduced")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--docs", default="docs/results")
     ap.add_argument("--command", default="./scripts/make-results.sh")
     ap.add_argument("--clamp", default="")
     ap.add_argument("--seeds", default="3")
+    ap.add_argument("--note", default="", help="a line on the run (scenes, budgets, seeds)")
     a = ap.parse_args()
 
     scenes = {}
@@ -311,16 +672,24 @@ def main():
     for name, _ in GLOSSY_SCENES:
         if os.path.exists(os.path.join(a.docs, f"{name}-median.csv")):
             glossy[name] = Scene(a.docs, name)
+    diffuse = {}
+    for name, _ in DIFFUSE_SCENES:
+        if os.path.exists(os.path.join(a.docs, f"{name}-median.csv")):
+            diffuse[name] = Scene(a.docs, name)
+    scal = read_scalability(a.docs)
 
     o = []
     o.append("# Results: error against render time\n")
     o.append(f"Regenerate everything on this page (text, tables, plots) with `{a.command}` "
-             f"(about 25 minutes on 2 cores). Generated {datetime.date.today().isoformat()} at "
+             f"(about 45 minutes on 2 cores). Generated {datetime.date.today().isoformat()} at "
              f"commit `{git_commit()}` on {machine()}, OpenCL on PoCL's CPU device.\n")
+    if a.note:
+        o.append(a.note + "\n")
     o.append(
         "Method (DESIGN.md §8): `canopy converge` renders every sampler configuration at "
         "1, 2, 4, ... spp until its budget of render seconds is spent, "
-        f"{a.seeds} seeds per point, and measures each image against a reference with "
+        "several seeds per point (given in each scene's section), and measures each image "
+        "against a reference with "
         "`canopy compare`'s metrics. The curves are medians over the seeds. Time is the "
         "renderer's wall time for the image (`RenderStats::render_seconds`: kernels, queues, "
         "host synchronisation), after one unrecorded warm-up render; scene loading, BVH and "
@@ -492,9 +861,11 @@ def main():
         "scenes, which is what issue 12 needs.\n")
 
     o.append(glossy_summary(glossy))
+    o.append(brdf_section(glossy, diffuse, scal, a.docs))
 
     # ------------------------------------------------------------------ scenes
-    for group, loaded, is_glossy in ((SCENES, scenes, False), (GLOSSY_SCENES, glossy, True)):
+    for group, loaded, is_glossy in ((SCENES, scenes, False), (GLOSSY_SCENES, glossy, True),
+                                     (DIFFUSE_SCENES, diffuse, True)):
         for name, title in group:
             o.append(f"## {name}\n")
             o.append(f"{title}: `scenes/{name}.json`.\n")

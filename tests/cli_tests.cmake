@@ -135,11 +135,21 @@ canopy_cli_test(cli_render_no_mis
   "-DSTDERR=sampler tree-split (threshold 0.25, max cut 64, no MIS)" -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_converge_bad_mis_suffix
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|power,tree-split:0.5/mis"
-  -DRC=2 "-DSTDERR=--samplers: 'tree-split:0.5/mis': unknown suffix '/mis' (the only one is /nomis: MIS off)"
+  -DRC=2 "-DSTDERR=--samplers: 'tree-split:0.5/mis': unknown or repeated suffix '/mis' (/nomis: MIS off; /equal: brdf-mis with equal allocation)"
   -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_converge_bsdf_nomis
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|bsdf/nomis"
   -DRC=2 "-DSTDERR=--samplers: 'bsdf/nomis': /nomis does not apply to bsdf (BSDF sampling only: there is no light sample to combine with)"
+  -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
+# Issue 12: brdf-mis/equal is brdf-mis with equal allocation; /equal means nothing to other
+# samplers, and brdf-mis:D takes delta in [0, 1000] (as render --brdf-delta), refused before rendering.
+canopy_cli_test(cli_converge_equal_not_brdf_mis
+  "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|brdf-mis/equal,power/equal"
+  -DRC=2 "-DSTDERR=--samplers: 'power/equal': /equal applies to brdf-mis only (equal allocation between its BRDF-oriented and BSDF samples)"
+  -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_converge_brdf_delta_range
+  "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|brdf-mis:0.05,brdf-oriented:1001"
+  -DRC=2 "-DSTDERR=--samplers: 'brdf-oriented:1001': the BRDF split threshold delta must be a number in [0, 1000]"
   -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
 # NaN is refused by every floating-point option, of every subcommand.
 canopy_cli_test(cli_converge_budget_nan

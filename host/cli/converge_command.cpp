@@ -49,21 +49,34 @@ struct ConvergeArgs {
 // "tree-noorient" = tree without Eq. 3's orientation terms (importance E / d^2: the ablation);
 // a trailing "/nomis" (e.g. "power/nomis", "tree-split:0.25/nomis") switches MIS off. Without it
 // MIS is on, whatever the scene's integrator says, so that a label names one configuration.
+// For the BRDF-oriented samplers (Liu et al. 2019) ":D" is the cut's split threshold delta on the
+// cap integral S_C (Eq. 5) instead, and "brdf-mis/equal" is brdf-mis with equal allocation, one
+// sample per technique (their Fig. 8); without /equal the allocation is adaptive (Alg. 1),
+// whatever the scene says. N_max and lambda come from the scene.
 struct SamplerConfig {
   std::string label, sampler;
   float threshold = 0.0f;
   bool orientation = true;
   bool mis = true;
+  BrdfSettings brdf;
 };
 
 constexpr std::string_view kNoOrientSuffix = "-noorient";
 constexpr std::string_view kNoMisSuffix = "nomis"; // after a '/'
+constexpr std::string_view kEqualSuffix = "equal"; // after a '/'
+constexpr float kMaxBrdfDelta = 1000.0f;           // as `canopy render --brdf-delta`
+
+bool is_brdf_sampler(const std::string& sampler) {
+  return sampler == "brdf-mis" || sampler == "brdf-oriented";
+}
 
 struct RunRecord {
   int spp = 0;
   uint32_t seed = 0;
   double seconds = 0.0;
   uint64_t shadow_rays = 0, shading_points = 0;
+  // BRDF samplers: glossy points and the sums over them of cut size and sample count N
+  uint64_t glossy_points = 0, brdf_cut_sum = 0, brdf_samples_sum = 0, brdf_rays = 0;
   ImageMetrics metrics;
 };
 
@@ -85,23 +98,42 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-SamplerConfig parse_config(const std::string& text, float default_threshold,
+// `scene` gives the defaults: the tree's split threshold and the BRDF samplers' settings.
+SamplerConfig parse_config(const std::string& text, const IntegratorSettings& scene,
                            const std::string& option) {
   SamplerConfig c;
   c.label = text;
+  c.threshold = scene.split_threshold;
+  c.brdf.delta = scene.brdf_delta;
+  c.brdf.n_max = scene.brdf_n_max;
+  c.brdf.lambda = scene.brdf_lambda;
+  c.brdf.adaptive = true;
   std::string spec = text;
+  bool equal = false;
   if (size_t slash = spec.find('/'); slash != std::string::npos) {
-    std::string suffix = spec.substr(slash + 1);
-    if (suffix != kNoMisSuffix)
-      throw SceneError(fmt::format("{}: '{}': unknown suffix '/{}' (the only one is /{}: MIS off)",
-                                   option, printable(text, 256), printable(suffix, 256),
-                                   kNoMisSuffix));
+    std::stringstream suffixes(spec.substr(slash + 1));
     spec.resize(slash);
-    c.mis = false;
+    std::string suffix;
+    bool any = false;
+    while (std::getline(suffixes, suffix, '/')) {
+      any = true;
+      if (suffix == kNoMisSuffix && c.mis) {
+        c.mis = false;
+      } else if (suffix == kEqualSuffix && !equal) {
+        equal = true;
+      } else {
+        throw SceneError(fmt::format("{}: '{}': unknown or repeated suffix '/{}' (/{}: MIS off; "
+                                     "/{}: brdf-mis with equal allocation)",
+                                     option, printable(text, 256), printable(suffix, 256),
+                                     kNoMisSuffix, kEqualSuffix));
+      }
+    }
+    if (!any)
+      throw SceneError(
+          fmt::format("{}: '{}': empty suffix after '/'", option, printable(text, 256)));
   }
   size_t colon = spec.find(':');
   c.sampler = spec.substr(0, colon);
-  c.threshold = default_threshold;
   if (c.sampler.size() > kNoOrientSuffix.size() && c.sampler.ends_with(kNoOrientSuffix)) {
     c.sampler.resize(c.sampler.size() - kNoOrientSuffix.size());
     c.orientation = false;
@@ -113,29 +145,55 @@ SamplerConfig parse_config(const std::string& text, float default_threshold,
     throw SceneError(fmt::format("{}: '{}': /{} does not apply to bsdf (BSDF sampling only: "
                                  "there is no light sample to combine with)",
                                  option, printable(text, 256), kNoMisSuffix));
+  if (!c.mis && is_brdf_sampler(c.sampler))
+    throw SceneError(fmt::format("{}: '{}': /{} does not apply to {} (it weights its own "
+                                 "techniques; brdf-oriented is the one without MIS)",
+                                 option, printable(text, 256), kNoMisSuffix, c.sampler));
+  if (equal && c.sampler != "brdf-mis")
+    throw SceneError(fmt::format("{}: '{}': /{} applies to brdf-mis only (equal allocation "
+                                 "between its BRDF-oriented and BSDF samples)",
+                                 option, printable(text, 256), kEqualSuffix));
+  c.brdf.adaptive = !equal;
   if (std::find(kLightSamplerNames.begin(), kLightSamplerNames.end(), c.sampler) ==
       kLightSamplerNames.end())
     throw SceneError(fmt::format("{}: unknown light sampler '{}' (one of {}; tree samplers take "
-                                 "-noorient; /nomis switches MIS off)",
+                                 "-noorient; /nomis switches MIS off; brdf-mis takes /equal)",
                                  option, c.sampler, fmt::join(kLightSamplerNames, ", ")));
   if (colon != std::string::npos) {
     std::string t = spec.substr(colon + 1);
     char* end = nullptr;
     double v = std::strtod(t.c_str(), &end);
-    if (t.empty() || *end != '\0' || !(v >= 0.0 && v <= 1.0))
-      throw SceneError(
-          fmt::format("{}: '{}': the split threshold must be a number in [0, 1]", option, text));
-    c.threshold = float(v);
+    bool brdf = is_brdf_sampler(c.sampler);
+    double hi = brdf ? double(kMaxBrdfDelta) : 1.0;
+    if (t.empty() || *end != '\0' || !(v >= 0.0 && v <= hi))
+      throw SceneError(fmt::format("{}: '{}': {} must be a number in [0, {}]", option, text,
+                                   brdf ? "the BRDF split threshold delta" : "the split threshold",
+                                   hi));
+    if (brdf)
+      c.brdf.delta = float(v);
+    else
+      c.threshold = float(v);
   }
   return c;
 }
 
-std::vector<SamplerConfig> parse_configs(const std::string& list, float default_threshold) {
+RendererOptions renderer_options(const SamplerConfig& c, const Scene& base) {
+  RendererOptions opt;
+  opt.light_sampler = c.sampler;
+  opt.split_threshold = c.threshold;
+  opt.max_cut = base.integrator.max_cut;
+  opt.orientation_term = c.orientation;
+  opt.mis = c.mis;
+  opt.brdf = c.brdf;
+  return opt;
+}
+
+std::vector<SamplerConfig> parse_configs(const std::string& list, const IntegratorSettings& scene) {
   std::vector<SamplerConfig> out;
   std::stringstream ss(list);
   std::string item;
   while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(parse_config(item, default_threshold, "--samplers"));
+    if (!item.empty()) out.push_back(parse_config(item, scene, "--samplers"));
   if (out.empty()) throw SceneError("--samplers: no sampler given");
   return out;
 }
@@ -241,16 +299,9 @@ std::ofstream open_out(const fs::path& file) {
 // E[MSE(A, B)] = 2 σ² and the mean has variance σ² / 2, so its MSE is about MSE(A, B) / 4. The
 // estimate uses the same --clamp as the measurements and is stored as canopy:reference_mse.
 void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, Progress& progress) {
-  SamplerConfig c =
-      parse_config(a.reference_sampler, base.integrator.split_threshold, "--reference-sampler");
+  SamplerConfig c = parse_config(a.reference_sampler, base.integrator, "--reference-sampler");
   Scene scene = base;
-  RendererOptions opt;
-  opt.light_sampler = c.sampler;
-  opt.split_threshold = c.threshold;
-  opt.max_cut = base.integrator.max_cut;
-  opt.orientation_term = c.orientation;
-  opt.mis = c.mis;
-  Renderer r(rt, scene, opt);
+  Renderer r(rt, scene, renderer_options(c, base));
   const int half_spp = std::max(1, a.reference_spp / 2);
   auto t0 = Clock::now();
   RgbImage halves[2];
@@ -295,25 +346,56 @@ void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, P
                 true);
 }
 
+// Mean BRDF-oriented cut size and BRDF-aware sample count per glossy point over `runs` (Liu et
+// al. 2019, Table 1-2 columns); 0 without glossy points (a sampler that is not brdf-mis or
+// brdf-oriented, or a scene without a glossy material).
+struct BrdfMeans {
+  uint64_t glossy_points = 0;
+  double cut = 0.0, samples = 0.0;
+};
+
+template <class Pred> BrdfMeans brdf_means(const std::vector<RunRecord>& runs, Pred include) {
+  BrdfMeans m;
+  uint64_t cut = 0, samples = 0;
+  for (const RunRecord& r : runs)
+    if (include(r)) {
+      m.glossy_points += r.glossy_points;
+      cut += r.brdf_cut_sum;
+      samples += r.brdf_samples_sum;
+    }
+  if (m.glossy_points > 0) {
+    m.cut = double(cut) / double(m.glossy_points);
+    m.samples = double(samples) / double(m.glossy_points);
+  }
+  return m;
+}
+
 void write_csvs(const fs::path& prefix, const std::string& scene, double ref_mse, double clamp,
                 const std::vector<ConfigResult>& results) {
   std::ofstream runs = open_out(prefix.string() + ".csv");
   runs << "scene,sampler,light_sampler,split_threshold,spp,seed,seconds,shadow_rays,shading_points,"
-          "rmse,relmse,psnr,reference_mse,clamp,mis\n";
+          "rmse,relmse,psnr,reference_mse,clamp,mis,brdf_delta,brdf_adaptive,glossy_points,"
+          "brdf_cut_sum,brdf_samples_sum,brdf_rays\n";
   for (const ConfigResult& r : results)
     for (const RunRecord& x : r.runs)
-      runs << fmt::format("{},{},{},{},{},{},{:.6f},{},{},{:.6e},{:.6e},{:.4f},{:.6e},{},{}\n",
-                          scene, r.config.label, r.config.sampler, r.config.threshold, x.spp,
-                          x.seed, x.seconds, x.shadow_rays, x.shading_points, x.metrics.rmse,
-                          x.metrics.relmse, x.metrics.psnr, ref_mse, clamp, int(r.config.mis));
+      runs << fmt::format(
+          "{},{},{},{},{},{},{:.6f},{},{},{:.6e},{:.6e},{:.4f},{:.6e},{},{},{},{},{},"
+          "{},{},{}\n",
+          scene, r.config.label, r.config.sampler, r.config.threshold, x.spp, x.seed, x.seconds,
+          x.shadow_rays, x.shading_points, x.metrics.rmse, x.metrics.relmse, x.metrics.psnr,
+          ref_mse, clamp, int(r.config.mis), r.config.brdf.delta, int(r.config.brdf.adaptive),
+          x.glossy_points, x.brdf_cut_sum, x.brdf_samples_sum, x.brdf_rays);
   std::ofstream med = open_out(prefix.string() + "-median.csv");
-  med << "scene,sampler,spp,runs,seconds,shadow_rays,rmse,relmse\n";
+  med << "scene,sampler,spp,runs,seconds,shadow_rays,rmse,relmse,glossy_points,brdf_mean_cut,"
+         "brdf_mean_samples\n";
   for (const ConfigResult& r : results)
     for (const MedianPoint& p : r.medians) {
       size_t n = size_t(std::count_if(r.runs.begin(), r.runs.end(),
                                       [&](const RunRecord& x) { return x.spp == p.spp; }));
-      med << fmt::format("{},{},{},{},{:.6f},{:.0f},{:.6e},{:.6e}\n", scene, r.config.label, p.spp,
-                         n, p.seconds, p.shadow_rays, p.rmse, p.relmse);
+      BrdfMeans bm = brdf_means(r.runs, [&](const RunRecord& x) { return x.spp == p.spp; });
+      med << fmt::format("{},{},{},{},{:.6f},{:.0f},{:.6e},{:.6e},{},{:.4f},{:.4f}\n", scene,
+                         r.config.label, p.spp, n, p.seconds, p.shadow_rays, p.rmse, p.relmse,
+                         bm.glossy_points, bm.cut, bm.samples);
     }
   std::ofstream cfg = open_out(prefix.string() + "-configs.csv");
   cfg << "scene,sampler,light_sampler,split_threshold,build_seconds,light_tree_seconds,"
@@ -333,7 +415,7 @@ int run_converge(const ConvergeArgs& a) {
     base.film.width = std::max(1, int(std::lround(base.film.width * a.film_scale)));
     base.film.height = std::max(1, int(std::lround(base.film.height * a.film_scale)));
   }
-  std::vector<SamplerConfig> configs = parse_configs(a.samplers, base.integrator.split_threshold);
+  std::vector<SamplerConfig> configs = parse_configs(a.samplers, base.integrator);
   if (a.spp_factor < 2) throw SceneError("--spp-factor: must be >= 2");
   fs::path prefix = a.out.empty()
                         ? fs::path("out") / (fs::path(a.scene).stem().string() + "-converge")
@@ -377,13 +459,8 @@ int run_converge(const ConvergeArgs& a) {
                               configs.size(), res.config.label),
                   false);
     scenes.push_back(std::make_unique<Scene>(base));
-    RendererOptions opt;
-    opt.light_sampler = res.config.sampler;
-    opt.split_threshold = res.config.threshold;
-    opt.max_cut = base.integrator.max_cut;
-    opt.orientation_term = res.config.orientation;
-    opt.mis = res.config.mis;
-    renderers.push_back(std::make_unique<Renderer>(rt, *scenes.back(), opt));
+    renderers.push_back(
+        std::make_unique<Renderer>(rt, *scenes.back(), renderer_options(res.config, base)));
     Renderer& renderer = *renderers.back();
     res.build_seconds = renderer.stats().build_seconds;
     res.light_tree_seconds = renderer.stats().light_tree_seconds;
@@ -423,6 +500,10 @@ int run_converge(const ConvergeArgs& a) {
         run.seconds = after.render_seconds - before.render_seconds;
         run.shadow_rays = after.shadow_rays - before.shadow_rays;
         run.shading_points = after.shading_points - before.shading_points;
+        run.glossy_points = after.glossy_points - before.glossy_points;
+        run.brdf_cut_sum = after.brdf_cut_sum - before.brdf_cut_sum;
+        run.brdf_samples_sum = after.brdf_samples_sum - before.brdf_samples_sum;
+        run.brdf_rays = after.brdf_rays - before.brdf_rays;
         run.metrics = compare_images(
             a.clamp > 0.0 ? clamp_image(film.mean(), float(a.clamp)) : film.mean(), ref);
         res.runs.push_back(run);
@@ -503,8 +584,14 @@ int run_converge(const ConvergeArgs& a) {
               t_eq);
   for (const ConfigResult& r : results) {
     double v = rmse_at(r.medians, t_eq, &ex);
-    std::printf("  %-16s %.4e  %.3fx %s%s\n", r.config.label.c_str(), v, v / base_rmse,
-                baseline->config.label.c_str(), ex ? "  (extrapolated as t^-1/2)" : "");
+    BrdfMeans bm = brdf_means(r.runs, [](const RunRecord&) { return true; });
+    std::string brdf = bm.glossy_points > 0 ? fmt::format("  (per glossy point: cut {:.2f}, "
+                                                          "BRDF-aware samples {:.2f})",
+                                                          bm.cut, bm.samples)
+                                            : std::string();
+    std::printf("  %-16s %.4e  %.3fx %s%s%s\n", r.config.label.c_str(), v, v / base_rmse,
+                baseline->config.label.c_str(), ex ? "  (extrapolated as t^-1/2)" : "",
+                brdf.c_str());
   }
   if (ref_mse > 0.0)
     std::printf("reference noise (estimated RMSE of the reference itself): %.3e\n",
@@ -529,7 +616,9 @@ CLI::App* add_converge_command(CLI::App& app, std::function<int()>& action) {
                   "tree-split, exhaustive, ...); tree-split:T sets the split threshold T; "
                   "tree-noorient and tree-split-noorient[:T] drop the orientation terms of the "
                   "importance; a trailing /nomis switches MIS off (e.g. power/nomis, "
-                  "tree-split:0.25/nomis; not for bsdf), else MIS is on")
+                  "tree-split:0.25/nomis; not for bsdf, brdf-mis, brdf-oriented), else MIS is on; "
+                  "brdf-mis:D and brdf-oriented:D set the BRDF split threshold delta D; "
+                  "brdf-mis/equal allocates BRDF-aware samples equally (else adaptively)")
       ->capture_default_str();
   cmd->add_option("--budget", a->budget, "Render seconds per configuration (all points and seeds)")
       ->check(CLI::PositiveNumber)
