@@ -106,6 +106,9 @@ Outcome run_case(ClRuntime& rt, const Case& c) {
   args.set("hist", hist);
   args.set("ids", ids);
   args.set("pmfs", pmfs);
+  // The BRDF-oriented cut storage the light-sampler parameters include (unused here: these picks
+  // are at points without a BRDF).
+  args.set("brdf_cut", cl::Buffer(ctx, CL_MEM_READ_WRITE, sizeof(float2)));
   BoundKernel k(program, "pick_lights", args);
   std::printf(", kernel built %.2f s", secs());
   enqueue_1d(rt.queue(), k.bind(), size_t(c.picks));
