@@ -214,6 +214,16 @@ TEST(SceneErrors, MaxDepthZero) {
             "scene.json: integrator.max_depth: must be in [1, 1024]");
 }
 
+TEST(SceneErrors, BrdfParametersOutOfRange) {
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"brdf_n_max": 0})")),
+            "scene.json: integrator.brdf_n_max: must be in [1, 1024]");
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"brdf_lambda": -1})")),
+            "scene.json: integrator.brdf_lambda: must be in [0.001, 1000000]");
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"brdf_adaptive": 1})"))
+                .rfind("scene.json: integrator.brdf_adaptive: ", 0),
+            0u);
+}
+
 TEST(SceneErrors, UnknownLightSampler) {
   EXPECT_EQ(error_of(scene_with(R"("integrator": {"light_sampler": "best"})")),
             "scene.json: integrator.light_sampler: unknown value \"best\" (expected one of: "
