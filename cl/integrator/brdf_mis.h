@@ -99,7 +99,7 @@ INLINE BrdfPoint brdf_point(const LightSamplerCtx* ls, const SceneBuffers* sc,
 
 // Probability that BRDF-oriented light sampling picks `light` at the point.
 INLINE float brdf_light_pmf(const LightSamplerCtx* ls, const BrdfPoint* bp, int light) {
-  return lt_brdf_pmf(&ls->tree, bp->cut, bp->state.x, bp->P, bp->N, light);
+  return lt_brdf_pmf(&ls->tree, bp->cut, bp->state.x, bp->P, bp->N, &bp->lobe, light);
 }
 
 // Weight of the tree light sample (density p_L) against N BRDF-aware samples drawn with share s
@@ -182,7 +182,7 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
     BrdfItem it;
     if (use_light) {
       float pmf;
-      int light = lt_brdf_pick(&ls->tree, bp.cut, bp.state.x, bp.P, bp.N, &rng, &pmf);
+      int light = lt_brdf_pick(&ls->tree, bp.cut, bp.state.x, bp.P, bp.N, &bp.lobe, &rng, &pmf);
       if (light < 0) continue;
       float u1 = lt_rng_next(&rng), u2 = lt_rng_next(&rng);
       LightPoint lp;

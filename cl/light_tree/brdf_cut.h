@@ -1,7 +1,7 @@
 // BRDF-oriented light sampling (Liu, Xu & Yan 2019, §4.1): per shading point a light cut chosen by
 // the cosine-weighted BRDF integrated over each cluster's bounding cap (S_C, Eq. 5), the cluster
 // importance I_C = E_C cos(theta_C) / d^2 * S_C / Omega_C (Eq. 6), a pick of one cluster of the
-// cut by importance, a stochastic descent below it (lt_brdf_pick), and the probability of
+// cut by importance, a stochastic descent below it by the same importance, and the probability of
 // any light under that technique (for MIS), recomputed along the light's bit-trail. Compiles as
 // OpenCL C and as C++ (cl/compat.h); the host tests and the kernels run the same code.
 #ifndef CANOPY_LIGHT_TREE_BRDF_CUT_H
@@ -11,9 +11,7 @@
 #include "../compat.h"
 #include "importance.h"
 #include "layout.h"
-#include "pmf.h"
 #include "rng.h"
-#include "traverse.h"
 
 // Capacity of a point's cut. The paper's cuts average 3.4 (delta 0.5) to 51 (delta 0.005) clusters
 // (Table 2); a cut that would grow past this stops splitting (it still covers every light, so the
@@ -191,15 +189,36 @@ INLINE float lt_brdf_entry_prob(GLOBAL const float2* cut, int n, int j) {
          lt_lane_prob(lt_brdf_cut_quad(cut, n, j >> 2), j & 3);
 }
 
+// Stochastic descent below `code` by the BRDF-oriented importance (§4.1 "Light cluster sampling":
+// sub-clusters are chosen recursively), each choice exact (lt_choose_lane). Returns the light or
+// -1; *prob = product of the lane probabilities. Eq. 6 all the way down costs four cap integrals
+// per level, but a cut entry can hold thousands of lights around a sharp lobe: descending by
+// Conty Estevez & Kulla's importance instead (which ignores the BRDF) was measured 1.5x noisier per
+// sample for brdf-mis and 4x for brdf-oriented on the showroom (docs/performance.md).
+INLINE int lt_brdf_pick_below(const LtTree* t, int code, float3 P, float3 Ng, const CapLobe* lobe,
+                              LtRng* rng, float* prob) {
+  float p = 1.0f;
+  *prob = 0.0f;
+  for (;;) {
+    float4 S;
+    int4 inside;
+    float4 imp = lt_brdf_code_importance(t, code, P, Ng, lobe, &S, &inside);
+    int lane = lt_choose_lane(imp, rng);
+    if (lane < 0) return -1;
+    p = p * lt_lane_prob(imp, lane);
+    if (code < 0) {
+      *prob = p;
+      return t->leaf_lights[lt_leaf_first(code) + lane];
+    }
+    code = i4_get(t->children[code], lane);
+    if (code == LT_EMPTY) return -1;
+  }
+}
+
 // One BRDF-oriented light pick: an entry of the cut by importance (three exact 4-way choices),
-// then a stochastic descent below it (§4.1 "we perform the light cluster sampling recursively
-// similar to [EK18]"). The descent ranks sub-clusters by Conty Estevez & Kulla's importance
-// (lt_pick_below), not by Eq. 6: the cut entries are the clusters whose caps hold at most delta
-// of the BRDF, so the BRDF varies little inside one, and Eq. 6 costs four cap integrals per level
-// (it made BRDF-oriented picks and pmfs 2-3x slower for no measurable gain on glossy-cornell).
-// Returns the light or -1; *pmf its probability.
+// then a descent below it. Returns the light or -1; *pmf its probability.
 INLINE int lt_brdf_pick(const LtTree* t, GLOBAL const float2* cut, int n, float3 P, float3 Ng,
-                        LtRng* rng, float* pmf) {
+                        const CapLobe* lobe, LtRng* rng, float* pmf) {
   *pmf = 0.0f;
   if (n <= 0) return -1;
   float g1[16];
@@ -216,10 +235,29 @@ INLINE int lt_brdf_pick(const LtTree* t, GLOBAL const float2* cut, int n, float3
   int j = 16 * a + 4 * b + c;
   float p_entry = lt_lane_prob(g2, a) * lt_lane_prob(ga, b) * lt_lane_prob(q, c);
   float p_below;
-  int light = lt_pick_below(t, (int)float_as_uint_(cut[j].x), P, Ng, rng, &p_below);
+  int light = lt_brdf_pick_below(t, (int)float_as_uint_(cut[j].x), P, Ng, lobe, rng, &p_below);
   if (light < 0) return -1;
   *pmf = p_entry * p_below;
   return light;
+}
+
+// Probability that lt_brdf_pick_below(code) returns the light whose remaining trail is `trail`.
+INLINE float lt_brdf_pmf_below(const LtTree* t, int code, uint trail, float3 P, float3 Ng,
+                               const CapLobe* lobe) {
+  float p = 1.0f;
+  for (;;) {
+    float4 S;
+    int4 inside;
+    float4 imp = lt_brdf_code_importance(t, code, P, Ng, lobe, &S, &inside);
+    int lane = (int)(trail & 3u);
+    trail = trail >> 2;
+    float pk = lt_lane_prob(imp, lane);
+    if (!(pk > 0.0f)) return 0.0f;
+    p = p * pk;
+    if (code < 0) return p;
+    code = i4_get(t->children[code], lane);
+    if (code == LT_EMPTY) return 0.0f;
+  }
 }
 
 INLINE int lt_brdf_cut_find(GLOBAL const float2* cut, int n, int code) {
@@ -231,19 +269,19 @@ INLINE int lt_brdf_cut_find(GLOBAL const float2* cut, int n, int code) {
 // Probability that lt_brdf_pick produces `light` (the cut is P's): follow the light's bit-trail
 // from the root to the cut entry that holds it, then the descent's lane probabilities below it.
 INLINE float lt_brdf_pmf(const LtTree* t, GLOBAL const float2* cut, int n, float3 P, float3 Ng,
-                         int light) {
+                         const CapLobe* lobe, int light) {
   uint trail = t->trails[light];
   int code = 0;
   for (;;) {
     int j = lt_brdf_cut_find(cut, n, code);
-    if (j >= 0) return lt_brdf_entry_prob(cut, n, j) * lt_pmf_below(t, code, P, Ng, trail);
+    if (j >= 0)
+      return lt_brdf_entry_prob(cut, n, j) * lt_brdf_pmf_below(t, code, trail, P, Ng, lobe);
     if (code == LT_EMPTY) return 0.0f;
     int lane = (int)(trail & 3u);
     trail = trail >> 2;
     if (code < 0) { // a split leaf: the emitter's own entry, if P's cut kept it
-      int one = lt_leaf_code(lt_leaf_first(code) + lane, 1);
-      j = lt_brdf_cut_find(cut, n, one);
-      return j >= 0 ? lt_brdf_entry_prob(cut, n, j) * lt_pmf_below(t, one, P, Ng, 0u) : 0.0f;
+      j = lt_brdf_cut_find(cut, n, lt_leaf_code(lt_leaf_first(code) + lane, 1));
+      return j >= 0 ? lt_brdf_entry_prob(cut, n, j) : 0.0f;
     }
     code = i4_get(t->children[code], lane);
   }
