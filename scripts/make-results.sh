@@ -162,9 +162,9 @@ for name in $SCENES; do
 done
 
 # A line on this run for the report: what was regenerated, and with which budgets.
-note="Last run ($(date -u '+%Y-%m-%d %H:%M') UTC): \`SCENES=\"$SCENES\"\`, render budget"
-note+=" ${BUDGET:-of the scene table (make-results.sh)} s per configuration, $SEEDS seeds per"
-note+=" point, reference spp ${REF_SPP:-of the scene table}"
+note="Last run ($(date -u '+%Y-%m-%d %H:%M') UTC): \`SCENES=\"$SCENES\"\`; render budget per"
+note+=" configuration ${BUDGET:+$BUDGET s}${BUDGET:-as in the scene table of make-results.sh},"
+note+=" $SEEDS seeds per point, reference spp ${REF_SPP:-as in the scene table}"
 case " $SCENES " in
   *" scalability "*) note+="; scalability: $SCALE_SPP spp x $SCALE_REPS renders at film scale $SCALE_FILM" ;;
 esac
