@@ -163,7 +163,9 @@ done
 
 # A line on this run for the report: what was regenerated, and with which budgets.
 note="Last run ($(date -u '+%Y-%m-%d %H:%M') UTC): \`SCENES=\"$SCENES\"\`; render budget per"
-note+=" configuration ${BUDGET:+$BUDGET s}${BUDGET:-as in the scene table of make-results.sh},"
+budget_text="as in the scene table of make-results.sh"
+if [ -n "${BUDGET:-}" ]; then budget_text="$BUDGET s"; fi
+note+=" configuration $budget_text,"
 note+=" $SEEDS seeds per point, reference spp ${REF_SPP:-as in the scene table}"
 case " $SCENES " in
   *" scalability "*) note+="; scalability: $SCALE_SPP spp x $SCALE_REPS renders at film scale $SCALE_FILM" ;;
