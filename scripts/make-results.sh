@@ -163,9 +163,8 @@ done
 
 # A line on this run for the report: what was regenerated, and with which budgets.
 note="Last run ($(date -u '+%Y-%m-%d %H:%M') UTC): \`SCENES=\"$SCENES\"\`; render budget per"
-budget_text="as in the scene table of make-results.sh"
-if [ -n "${BUDGET:-}" ]; then budget_text="$BUDGET s"; fi
-note+=" configuration $budget_text,"
+if [ -n "${BUDGET:-}" ]; then note+=" configuration $BUDGET s,"
+else note+=" configuration as in the scene table of make-results.sh,"; fi
 note+=" $SEEDS seeds per point, reference spp ${REF_SPP:-as in the scene table}"
 case " $SCENES " in
   *" scalability "*) note+="; scalability: $SCALE_SPP spp x $SCALE_REPS renders at film scale $SCALE_FILM" ;;
