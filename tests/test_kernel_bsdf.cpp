@@ -14,6 +14,7 @@
 #include "cl/runtime.h"
 #include "render/device_scene.h"
 #include "render/features.h"
+#include "support/materials.h"
 #include "support/probe_program.h"
 
 #include "bsdf/bsdf.h"
@@ -51,28 +52,14 @@ __kernel void bsdf_probe(__global const Material* mats, __global const float4* w
 }
 )CL";
 
-Material conductor(float alpha) {
-  Material m{};
-  m.specular = make_float4(0.18f, 0.42f, 1.37f, 0); // gold-like eta
-  m.k = make_float4(3.42f, 2.35f, 1.77f, 0);
-  m.alpha = alpha;
-  m.type = MATERIAL_CONDUCTOR;
-  return m;
+Material conductor(float alpha) { // gold-like
+  return make_conductor(make_float3(0.18f, 0.42f, 1.37f), make_float3(3.42f, 2.35f, 1.77f), alpha);
 }
 Material plastic(float alpha) {
-  Material m{};
-  m.albedo = make_float4(0.6f, 0.3f, 0.1f, 0);
-  m.specular = make_float4(1, 0.8f, 0.6f, 0);
-  m.ior = 1.5f;
-  m.alpha = alpha;
-  m.type = MATERIAL_PLASTIC;
-  return m;
+  return make_plastic(make_float3(0.6f, 0.3f, 0.1f), make_float3(1, 0.8f, 0.6f), 1.5f, alpha);
 }
 Material diffuse() {
-  Material m{};
-  m.albedo = make_float4(0.8f, 0.5f, 0.2f, 0);
-  m.type = MATERIAL_DIFFUSE;
-  return m;
+  return make_diffuse(make_float3(0.8f, 0.5f, 0.2f));
 }
 
 struct Probes {
