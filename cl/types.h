@@ -56,6 +56,17 @@ typedef struct Material {
   int pad;
 } Material;
 
+// ---------------------------------------------------------------- participating media
+// A homogeneous medium (docs/scene-format.md "medium"; cl/volume/medium.h): coefficients per scene
+// unit of length, a Henyey-Greenstein phase function, everywhere or inside an axis-aligned box
+// (no surface: rays enter and leave it freely).
+typedef struct Medium {
+  float4 sigma_t; // rgb: sigma_a + sigma_s; w: Henyey-Greenstein g in (-1, 1)
+  float4 sigma_s; // rgb: scattering coefficient; w: 1 if bounded by [bmin, bmax], 0 if unbounded
+  float4 bmin;    // bounded: the box's minimum corner (xyz)
+  float4 bmax;    // bounded: the box's maximum corner (xyz)
+} Medium;
+
 // ---------------------------------------------------------------- geometry / BVH
 // A primitive is a triangle, a sphere or a disk. Vertices are stored with the primitive so the
 // intersect kernel reads one contiguous record.

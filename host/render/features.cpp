@@ -27,6 +27,7 @@ KernelFeatures KernelFeatures::all(int light_sampler) {
   f.light_disk = true;
   f.prim_sphere = f.prim_disk = true;
   f.material_conductor = f.material_plastic = true;
+  f.medium = true;
   f.light_sampler = light_sampler;
   return f;
 }
@@ -35,11 +36,11 @@ std::string KernelFeatures::build_options() const {
   return fmt::format("-DCANOPY_FEATURES_SET -DHAS_LIGHT_POINT={} -DHAS_LIGHT_SPOT={} "
                      "-DHAS_LIGHT_SPHERE={} -DHAS_LIGHT_QUAD={} -DHAS_LIGHT_TRIANGLE={} "
                      "-DHAS_LIGHT_DISK={} -DHAS_PRIM_SPHERE={} -DHAS_PRIM_DISK={} "
-                     "-DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} "
+                     "-DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} -DHAS_MEDIUM={} "
                      "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={}",
                      int(light_point), int(light_spot), int(light_sphere), int(light_quad),
                      int(light_triangle), int(light_disk), int(prim_sphere), int(prim_disk),
-                     int(material_conductor), int(material_plastic), light_sampler, int(mis));
+                     int(material_conductor), int(material_plastic), int(medium), light_sampler, int(mis));
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {

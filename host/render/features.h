@@ -13,6 +13,7 @@ struct KernelFeatures {
        light_triangle = false, light_disk = false;
   bool prim_sphere = false, prim_disk = false;
   bool material_conductor = false, material_plastic = false;
+  bool medium = false; // a participating medium (cl/volume/, shade_volume)
   int light_sampler = 0; // SAMPLER_* (cl/types.h)
   bool mis = true;       // RendererOptions::mis
 

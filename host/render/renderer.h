@@ -60,7 +60,8 @@ struct alignas(16) double2 {
   double x, y;
 };
 static_assert(sizeof(double4) == 32 && sizeof(double2) == 16);
-static_assert(sizeof(Material) == 64 && sizeof(Light) == 96 && sizeof(Primitive) == 64);
+static_assert(sizeof(Material) == 64 && sizeof(Light) == 96 && sizeof(Primitive) == 64 &&
+              sizeof(Medium) == 64);
 
 // Per-pixel running sums in double, in the scene's emission units (the device's emission scale
 // already undone): sum.xyz = radiance sum, sum.w = sample count, sumsq = second moment.
