@@ -473,3 +473,45 @@ TEST(LightTreeSegment, PointQueriesEqualPointForms) {
     ASSERT_EQ(p3, p4);
   }
 }
+
+// The orientation ablation (LT_TERMS_DISTANCE) drops the cones but keeps the segment: four spot
+// lights (radius 0, one per lane of the root) get pmf E_l / d_l normalised, d_l the distance from
+// light l to the segment, whatever their axes; the full measure culls the spots facing away.
+TEST(LightTreeSegment, OrientationAblationRanksByEnergyOverDistance) {
+  std::vector<Light> lights = {make_spot_light(make_float3(1, 2, 0), make_float3(0, -1, 0), 0.8f,
+                                               0.9f, make_float3(3, 3, 3)),
+                               make_spot_light(make_float3(-2, 1, 1), make_float3(0, 1, 0), 0.8f,
+                                               0.9f, make_float3(1, 1, 1)),
+                               make_spot_light(make_float3(0, -1, 3), make_float3(1, 0, 0), 0.5f,
+                                               0.7f, make_float3(2, 1, 1)),
+                               make_spot_light(make_float3(4, 3, -2),
+                                               make_float3(-1, -1, 0) / std::sqrt(2.0f), 0.9f,
+                                               0.95f, make_float3(5, 4, 4))};
+  LightTree ablation = build_light_tree(lights), full = build_light_tree(lights);
+  ablation.set_orientation_term(false);
+  ASSERT_EQ(ablation.num_nodes(), 1);
+  for (int lane = 0; lane < 4; ++lane) { // one light per lane, or one leaf: exact ratios
+    int code = i4_get(ablation.children[0], lane);
+    ASSERT_TRUE(code == LT_EMPTY || (lt_is_leaf(code) && (lt_leaf_count(code) == 1 ||
+                                                          ablation.children[0].y == LT_EMPTY)));
+  }
+  LtTree ta = ablation.view(lights.data()), tf = full.view(lights.data());
+  int culled = 0;
+  for (LtQuery q : {lt_query_segment(make_float3(0.5f, 0, 0), make_float3(0, 0, 1), 2.0f),
+                    lt_query_segment(make_float3(-3, 0, 0), make_float3(1, 0, 0), 6.0f),
+                    lt_query_segment(make_float3(0, 5, 0), normalize(make_float3(1, -1, 1)), 1.0f),
+                    lt_query_segment(make_float3(2, 2, 2), make_float3(0, 1, 0), 0.0f)}) {
+    double w[4], sum = 0;
+    for (int l = 0; l < 4; ++l) {
+      float3 c = xyz_of(lights[size_t(l)].p);
+      float3 x = lt_query_closest(&q, c);
+      sum += w[l] = emitter_bounds(lights[size_t(l)]).energy / std::sqrt(dot_d(x - c, x - c));
+    }
+    for (int l = 0; l < 4; ++l) {
+      EXPECT_NEAR(lt_pmf_below_q(&ta, 0, &q, ablation.trails[size_t(l)]), w[l] / sum, 2e-6)
+          << "light " << l;
+      culled += lt_pmf_below_q(&tf, 0, &q, full.trails[size_t(l)]) == 0.0f;
+    }
+  }
+  EXPECT_GT(culled, 2);
+}
