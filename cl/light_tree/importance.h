@@ -162,12 +162,12 @@ LT_HOT v4f lt_importance_v(const LtLanes* l, float3 P, float3 N, int fallback) {
 // the segment's line. The same maximum in the basis (w/D, d), w = the vector from c to the foot of
 // the perpendicular on the line, D = |w|: x(s) - c = w + s d, s in [s_a, s_b] = [(a - c).d,
 // (a - c).d + len], and (w + s d).axis / |w + s d| is stationary at s* = D^2 (d.axis) / (w.axis),
-// a maximum iff w.axis > 0 (the o1.a > 0 of Eq. 6), of value sqrt((w.axis)^2 + D^2 (d.axis)^2) / D
-// (Eq. 6's second case); if s* is outside [s_a, s_b] (Eq. 6's v0.v1 > cos phi0) or w.axis <= 0 the
-// maximum is b_max, the larger endpoint cosine. Where c is within D < 1e-3 |x - c| of the line
-// with its foot on the segment, the direction of w is rounding noise and cos theta_min = 1
-// (conservative; a cluster with r > 0 there has theta_u = pi anyway). A zero-length segment is a
-// point (s_a = s_b).
+// the maximum over the whole line iff w.axis > 0, of value sqrt((w.axis)^2 + D^2 (d.axis)^2) / D
+// (Eq. 6's second case: phi0 within the arc); if w.axis <= 0 or s* is outside [s_a, s_b] (Eq. 6's
+// first case: o1.a < 0 or v0.v1 > cos phi0) the maximum is b_max, the larger endpoint cosine. Where
+// c is within D <= 1e-3 sqrt(s_a^2 + s_b^2) of the line with its foot on the segment, the direction
+// of w is rounding noise and cos theta_min = 1 (conservative: some plane through the line holds the
+// axis). A zero-length segment is a point (s_a = s_b).
 //
 // Half-space bound (one-sided planar lanes): dot(axis, x - c) + h + LT_PLANE_SLOPE |x - c| is
 // convex in x, so it is positive somewhere on the segment iff it is at an end: the lane is culled
