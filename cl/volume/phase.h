@@ -1,4 +1,4 @@
-// The Henyey-Greenstein phase function (pbrt-v3 §11.2.1; sampling §15.2.3).
+// The Henyey-Greenstein phase function (pbrt-v3 §11.2; sampling §15.2.3).
 //
 // Convention: theta is the angle between the light's direction of travel before and after
 // scattering. A path traced from the camera along unit d that scatters and continues towards the
