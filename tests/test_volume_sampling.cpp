@@ -355,6 +355,10 @@ const Segment kSegments[] = {
     {"long segment", make_float3(0, 0, 0), make_float3(0, 0, 1), 1e6f, make_float3(2, 1, 0)},
     {"long, light behind", make_float3(0, 0, 0), make_float3(0, 0, 1), 1e6f,
      make_float3(0.5f, 0, -2)},
+    {"infinite", make_float3(1, 1, 1), normalize(make_float3(1, -1, 2)), kInf,
+     make_float3(2, 0.5f, 3)},
+    {"infinite, light behind", make_float3(0, 0, 0), make_float3(1, 0, 0), kInf,
+     make_float3(-4, 1, 0)},
 };
 
 TEST(VolumeEquiangular, PdfIntegratesToOneAndMatchesClosedForm) {
@@ -367,17 +371,24 @@ TEST(VolumeEquiangular, PdfIntegratesToOneAndMatchesClosedForm) {
       cuts.push_back(double(r.delta - k * r.dist));
       cuts.push_back(double(r.delta + k * r.dist));
     }
-    double total = simpson_split(pdf, 0, s.len, cuts, 1e-7);
+    // an infinite segment: quadrature up to 1e7, the tail beyond in closed form
+    double end = std::isinf(s.len) ? 1e7 : double(s.len);
+    double tail = std::isinf(s.len)
+                      ? double((std::atan2(r.dist, end - r.delta)) / r.theta) // pi/2 - atan
+                      : 0.0;
+    double total = simpson_split(pdf, 0, end, cuts, 1e-7) + tail;
     EXPECT_NEAR(total, 1.0, 1e-5) << s.name;
     for (int i = 0; i <= 100; ++i) {
-      float t = s.len * float(i) / 100;
+      float t = std::isinf(s.len) ? 0.1f * float(i * i) : s.len * float(i) / 100;
       long double x = t - r.delta;
       long double ref = r.dist / (r.theta * (r.dist * r.dist + x * x));
       EXPECT_NEAR(equiangular_pdf(s.o, s.d, s.len, s.c, t), double(ref), 2e-5 * double(ref))
           << s.name << " t " << t;
     }
     EXPECT_EQ(equiangular_pdf(s.o, s.d, s.len, s.c, -1e-3f), 0.0f) << s.name;
-    EXPECT_EQ(equiangular_pdf(s.o, s.d, s.len, s.c, s.len * 1.001f), 0.0f) << s.name;
+    if (!std::isinf(s.len)) {
+      EXPECT_EQ(equiangular_pdf(s.o, s.d, s.len, s.c, s.len * 1.001f), 0.0f) << s.name;
+    }
   }
 }
 
@@ -398,7 +409,7 @@ TEST(VolumeEquiangular, SamplesFollowDensity) {
     for (int i = 0; i < kN; ++i) {
       float pdf = -1;
       float t = equiangular_sample(s.o, s.d, s.len, s.c, rng.next(), &pdf);
-      ASSERT_TRUE(t >= 0 && t <= s.len) << s.name << " t " << t;
+      ASSERT_TRUE(t >= 0 && t <= s.len && std::isfinite(t)) << s.name << " t " << t;
       ASSERT_EQ(pdf, equiangular_pdf(s.o, s.d, s.len, s.c, t)) << s.name << " t " << t;
       ASSERT_TRUE(std::isfinite(pdf) && pdf > 0) << s.name << " t " << t;
       int k = int(std::upper_bound(edges.begin(), edges.end(), double(t)) - edges.begin()) - 1;
@@ -437,7 +448,7 @@ TEST(VolumeEquiangular, LightOnTheLineStaysNormalised) {
 
 TEST(VolumeEquiangular, ExtremeInputsFinite) {
   const float3 o = make_float3(1, 2, 3), d = normalize(make_float3(0.2f, -1, 0.4f));
-  const float lens[] = {0.0f, 1e-30f, 1e-6f, 1.0f, 1e6f};
+  const float lens[] = {0.0f, 1e-30f, 1e-6f, 1.0f, 1e6f, kInf};
   const float offs[] = {0.0f, 1e-30f, 1e-7f, 1.0f, 1e6f};  // distance from the line
   const float alongs[] = {-1e6f, -1.0f, 0.0f, 0.5f, 1e6f}; // delta
   const float us[] = {0.0f, 1e-7f, 0.5f, 0.99999994f};
@@ -452,15 +463,20 @@ TEST(VolumeEquiangular, ExtremeInputsFinite) {
           float t = equiangular_sample(o, d, len, c, u, &pdf);
           std::string what = "len " + std::to_string(len) + " off " + std::to_string(off) +
                              " along " + std::to_string(along) + " u " + std::to_string(u);
-          ASSERT_TRUE(std::isfinite(t) && t >= 0 && t <= len) << what << ": t " << t;
+          // an infinite segment may give t = +inf with pdf 0 for u within rounding of 1
+          bool inf_end = std::isinf(len) && u > 0.5f;
+          ASSERT_TRUE((std::isfinite(t) || inf_end) && t >= 0 && t <= len) << what << ": t " << t;
           ASSERT_TRUE(std::isfinite(pdf) && pdf >= 0) << what << ": pdf " << pdf;
           ASSERT_EQ(pdf, equiangular_pdf(o, d, len, c, t)) << what;
+          if (std::isinf(t)) {
+            ASSERT_EQ(pdf, 0.0f) << what;
+          }
           // every segment of positive length that D len resolves gives a sample
-          if (len >= 1e-6f) {
+          if (len >= 1e-6f && !inf_end) {
             ASSERT_GT(pdf, 0) << what;
           }
           sampled += pdf > 0;
-          for (float tt : {0.0f, 0.5f * len, len}) {
+          for (float tt : {0.0f, std::fmin(0.5f * len, 1e30f), len}) {
             float p = equiangular_pdf(o, d, len, c, tt);
             ASSERT_TRUE(std::isfinite(p) && p >= 0) << what << " t " << tt;
           }

@@ -21,6 +21,8 @@
 //   for a light on the line (D = 0) the density would be a non-integrable 1 / (t - delta)^2.
 //   The clamp keeps the density normalised (a Cauchy bump as narrow as the coordinates resolve).
 // - len <= 0 or Theta == 0 (len below what D len resolves): no sample, pdf 0 (the caller skips it).
+// - len = +inf (a ray leaving an unbounded medium) is allowed: theta_b = pi / 2. A u within
+//   rounding of 1 can then give t = +inf with pdf 0 (no sample).
 #ifndef CANOPY_CL_VOLUME_EQUIANGULAR_H
 #define CANOPY_CL_VOLUME_EQUIANGULAR_H
 
@@ -41,7 +43,12 @@ INLINE EquiangularGeom equiangular_geom(float3 o, float3 d, float len, float3 c)
   g.delta = dot(oc, d);
   float scale = max3(fabs(o)) + max3(fabs(c));
   g.dist = fmax(length(cross(oc, d)), fmax(EQUIANGULAR_D_REL * scale, 1e-18f));
-  g.theta = len > 0.0f ? atan2(g.dist * len, g.dist * g.dist - g.delta * (len - g.delta)) : 0.0f;
+  if (!(len > 0.0f))
+    g.theta = 0.0f;
+  else if (len < FLT_INF)
+    g.theta = atan2(g.dist * len, g.dist * g.dist - g.delta * (len - g.delta));
+  else // theta_b = pi / 2: Theta = pi / 2 - theta_a, the angle of (-delta, D)
+    g.theta = atan2(g.dist, -g.delta);
   return g;
 }
 
