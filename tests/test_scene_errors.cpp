@@ -1045,13 +1045,15 @@ TEST(SceneErrors, MediumValues) {
             "scene.json: medium.g: must be in (-1, 1)");
   EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": 0.1, "density": 1)"),
             "scene.json: medium.density: unknown key");
-  EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": 0.1, "bounds": {"min": [0, 0, 0], "max": [1, 0, 1]})"),
-            "scene.json: medium.bounds.max: must exceed bounds.min in every coordinate");
+  EXPECT_EQ(
+      medium(R"("sigma_a": 0, "sigma_s": 0.1, "bounds": {"min": [0, 0, 0], "max": [1, 0, 1]})"),
+      "scene.json: medium.bounds.max: must exceed bounds.min in every coordinate");
   EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": 0.1, "bounds": {"min": [0, 0, 0]})"),
             "scene.json: medium.bounds.max: required key is missing");
-  EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": 0.1, "bounds": {"min": [0, 0, 0], "max": [1e19, 1, 1]})")
-                .rfind("scene.json: medium.bounds.max: ", 0),
-            0u);
+  EXPECT_EQ(
+      medium(R"("sigma_a": 0, "sigma_s": 0.1, "bounds": {"min": [0, 0, 0], "max": [1e19, 1, 1]})")
+          .rfind("scene.json: medium.bounds.max: ", 0),
+      0u);
   EXPECT_EQ(error_of(scene_with(R"("integrator": {"volume_importance": "centre"})")),
             "scene.json: integrator.volume_importance: unknown value \"centre\" (expected one of: "
             "segment, midpoint)");

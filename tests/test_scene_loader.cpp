@@ -521,7 +521,7 @@ TEST(SceneLoader, Medium) {
   Scene u = load_str(head + R"("medium": {"sigma_a": 0, "sigma_s": [0, 0.1, 0]},
     "integrator": {"volume_importance": "midpoint"}})");
   ASSERT_TRUE(u.has_medium);
-  EXPECT_EQ(u.medium.sigma_s.w, 0.0f); // fills all space
+  EXPECT_EQ(u.medium.sigma_s.w, 0.0f);       // fills all space
   EXPECT_FLOAT_EQ(u.medium.sigma_t.w, 0.0f); // g defaults to isotropic
   EXPECT_EQ(u.integrator.volume_importance, "midpoint");
 

@@ -65,10 +65,10 @@ struct SamplerConfig {
 };
 
 constexpr std::string_view kNoOrientSuffix = "-noorient";
-constexpr std::string_view kNoMisSuffix = "nomis"; // after a '/'
-constexpr std::string_view kEqualSuffix = "equal"; // after a '/'
+constexpr std::string_view kNoMisSuffix = "nomis";       // after a '/'
+constexpr std::string_view kEqualSuffix = "equal";       // after a '/'
 constexpr std::string_view kMidpointSuffix = "midpoint"; // after a '/'
-constexpr float kMaxBrdfDelta = 1000.0f;           // as `canopy render --brdf-delta`
+constexpr float kMaxBrdfDelta = 1000.0f;                 // as `canopy render --brdf-delta`
 
 bool is_brdf_sampler(const std::string& sampler) {
   return sampler == "brdf-mis" || sampler == "brdf-oriented";

@@ -40,7 +40,8 @@ std::string KernelFeatures::build_options() const {
                      "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={} -DCANOPY_VOLUME_MIDPOINT={}",
                      int(light_point), int(light_spot), int(light_sphere), int(light_quad),
                      int(light_triangle), int(light_disk), int(prim_sphere), int(prim_disk),
-                     int(material_conductor), int(material_plastic), int(medium), light_sampler, int(mis), int(volume_midpoint));
+                     int(material_conductor), int(material_plastic), int(medium), light_sampler,
+                     int(mis), int(volume_midpoint));
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {

@@ -27,9 +27,9 @@ cl::Buffer device_buffer(const cl::Context& ctx, size_t bytes) {
 }
 
 const std::vector<std::string> kKernelFiles = {
-    "kernels/compact.cl",      "kernels/generate.cl",      "kernels/intersect_closest.cl",
-    "kernels/shade_volume.cl", "kernels/shade_surface.cl", "kernels/light_pick.cl",
-    "kernels/intersect_shadow.cl", "kernels/brdf_mis.cl",  "kernels/accumulate.cl"};
+    "kernels/compact.cl",          "kernels/generate.cl",      "kernels/intersect_closest.cl",
+    "kernels/shade_volume.cl",     "kernels/shade_surface.cl", "kernels/light_pick.cl",
+    "kernels/intersect_shadow.cl", "kernels/brdf_mis.cl",      "kernels/accumulate.cl"};
 
 constexpr int kScanBlock = 256;
 constexpr int kCutBins = 65;
@@ -145,11 +145,13 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   t0 = Clock::now();
   KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_.kind)
                                                  : scene_features(scene, sampler_.kind);
-  features.volume_midpoint =
-      scene.has_medium && scene.integrator.volume_importance == "midpoint";
+  features.volume_midpoint = scene.has_medium && scene.integrator.volume_importance == "midpoint";
   features.mis = options.mis;
   brdf_stages_ =
       sampler_.brdf_oriented() && (features.material_conductor || features.material_plastic);
+  // Kernels with the medium feature run shade_volume (on a scene without a medium, its record is
+  // vacuum: every path passes unchanged, so forcing the feature on changes no image).
+  volume_stages_ = features.medium;
   stats_.kernel_options = features.build_options();
   program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
@@ -166,7 +168,7 @@ Film Renderer::render(const RenderSettings& settings) {
   // Every path's cut has at most max_cut items in any pass, so waves of
   // split_queue_items / max_cut paths bound the split queue. With a medium a path has two cuts (its
   // segment's and its surface point's), and a split item stages up to 8 shadow items, not 4.
-  const bool medium = scene_.has_medium;
+  const bool medium = volume_stages_;
   const size_t roots = medium ? 2 : 1, shadow_slots = medium ? 8 : 4;
   size_t wave = std::max<size_t>(
       1, std::min(settings.wave_size, options_.split_queue_items / (roots * sampler_.max_cut)));
@@ -301,8 +303,7 @@ Film Renderer::render(const RenderSettings& settings) {
     for (int depth = 0; depth < max_depth && count > 0; ++depth) {
       run("intersect_closest", k_closest.bind({{"queue", *q_in}, {"count", count}}), size_t(count));
       if (medium)
-        run("shade_volume",
-            k_volume->bind({{"depth", depth}, {"queue", *q_in}, {"count", count}}),
+        run("shade_volume", k_volume->bind({{"depth", depth}, {"queue", *q_in}, {"count", count}}),
             size_t(count));
       run("shade_surface", k_shade.bind({{"depth", depth}, {"queue", *q_in}, {"count", count}}),
           size_t(count));

@@ -127,7 +127,8 @@ private:
   LightSamplerData sampler_;
   RenderStats stats_;
   cl::Program program_;
-  bool brdf_stages_ = false; // brdf-mis / brdf-oriented on a scene with a glossy material
+  bool brdf_stages_ = false;   // brdf-mis / brdf-oriented on a scene with a glossy material
+  bool volume_stages_ = false; // kernels with a medium: shade_volume and segment light picks
   DeviceScene device_;
   cl::Buffer camera_;
 };

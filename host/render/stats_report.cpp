@@ -95,9 +95,9 @@ std::string stats_to_table(const RenderStats& s, const RunTimings& run) {
                        s.medium_segments, s.medium_shadow_rays,
                        double(s.medium_shadow_rays) / double(s.medium_segments),
                        s.shadow_rays - s.medium_shadow_rays,
-                       s.shading_points ? double(s.shadow_rays - s.medium_shadow_rays) /
-                                              double(s.shading_points)
-                                        : 0.0);
+                       s.shading_points
+                           ? double(s.shadow_rays - s.medium_shadow_rays) / double(s.shading_points)
+                           : 0.0);
   const CutTotals ct = cut_totals(s);
   out += fmt::format("cut members {}{} ({:.1f}% yield a shadow ray)\n",
                      ct.exact ? "" : ">= ", ct.members,

@@ -247,7 +247,8 @@ void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
   if (auto x = o.get("brdf_n_max")) in.brdf_n_max = int(x->as_int(1, kMaxBrdfSamples));
   if (auto x = o.get("brdf_lambda")) in.brdf_lambda = x->as_float_in(1e-3f, 1e6f);
   if (auto x = o.get("brdf_adaptive")) in.brdf_adaptive = x->as_bool();
-  if (auto x = o.get("volume_importance")) in.volume_importance = x->as_enum({"segment", "midpoint"});
+  if (auto x = o.get("volume_importance"))
+    in.volume_importance = x->as_enum({"segment", "midpoint"});
 }
 
 // The top-level "medium" (docs/scene-format.md, Participating media): homogeneous, everywhere or
