@@ -85,11 +85,17 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
     pb->throughput[path] = f4_from3(beta, 0.0f);
     return lights;
   }
-  // The path reaches its hit (an escaped ray has nothing left to weight).
+  // The path reaches its hit (an escaped ray has nothing left to weight); nothing reaches it
+  // through a medium that dense: the path ends.
   if (h.prim >= 0) {
     float3 tr = medium_tr(&m, full);
     if (continues) tr = tr * (1.0f / medium_survival(&m, full));
-    pb->throughput[path] = f4_from3(beta * tr, 0.0f);
+    beta = beta * tr;
+    pb->throughput[path] = f4_from3(beta, 0.0f);
+    if (!(max3(beta) > 0.0f)) {
+      h.prim = -1;
+      pb->hits[path] = h;
+    }
   }
   return lights;
 }
