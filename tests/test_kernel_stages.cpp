@@ -604,7 +604,7 @@ INSTANTIATE_TEST_SUITE_P(Samplers, KernelStages,
                          ::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive",
                                            "tree-noorient", "tree-split-noorient", "brdf-mis",
                                            "brdf-mis-equal", "brdf-oriented", "power-medium",
-                                           "tree-medium", "tree-split-medium", "brdf-mis-medium"),
+                                           "tree-split-medium", "brdf-mis-medium"),
                          [](const auto& p) {
                            std::string s = p.param;
                            for (char& c : s)
