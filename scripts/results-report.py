@@ -709,8 +709,9 @@ def fog_section(fog, docs):
         "dmin); `/midpoint` is the ablation that ranks them by the surface importance at the "
         "segment's midpoint (without a normal); `power` picks lights by emitted power alone "
         "(the paper's \"energy based sampling\"). Surface points are sampled by the "
-        "configuration's light sampler (`/midpoint` changes segments only). RMSE at equal render time per image (the scene's equal time, the "
-        "longest time every curve reaches, * = extended with t^-1/2), medians of the seeds.\n")
+        "configuration's light sampler (`/midpoint` changes segments only). RMSE at equal "
+        "render time per image (the scene's equal time, the longest time every curve reaches, "
+        "* = extended with t^-1/2), medians of the seeds.\n")
     if not fog:
         o.append("Not run (neither fog scene was rendered).\n")
         return "\n".join(o)
