@@ -9,6 +9,8 @@
 //   PickCpu/<N>/<sampler>        one light_sampler_pick (the device function) per random shading
 //                                point on the host, one thread; counter cpu_ns_per_pick (thread CPU
 //                                time, less sensitive to other load than wall time)
+//   PickCpuQuery/<N>/<kind>      the same through light_sampler_pick_q (tree): kind 0 point
+//                                queries, 1 ray segments in a medium (§5.2)
 //   DevicePick/<N>/<sampler>     the same picks in an OpenCL kernel (PoCL); counter
 //                                cpu_ns_per_pick = process CPU time (all device threads) per pick
 // sampler: 0 uniform, 1 power, 2 tree (random points layout).
@@ -209,6 +211,48 @@ void BM_PickCpu(benchmark::State& state) {
   state.counters["cpu_ns_per_pick"] = 1e9 * cpu / double(picks);
 }
 
+// The query forms as the integrator calls them: the query's kind is known at run time only, so a
+// point query pays the segment test once per node (HAS_MEDIUM is on on the host).
+__attribute__((noinline)) int pick_one_q(const LightSamplerCtx* ls, const LtQuery* q, LtRng* rng,
+                                         float* pmf) {
+  return light_sampler_pick_q(ls, 0, q, rng, pmf);
+}
+
+// range(1): 0 point queries (compare PickCpu/<N>/2), 1 segments of length 0.1 of the lights'
+// extent from the same points in random directions.
+void BM_PickCpuQuery(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const std::vector<Light>& lights = lights_for(n, 0);
+  LightSamplerData data = make_light_sampler_data(lights, "tree", 0.0f, 1);
+  LightSamplerCtx ls = data.host_view(lights);
+  const int kPoints = 4096, kPicks = 100000;
+  std::vector<Shading> pts = shading_points(lights, 0, kPoints);
+  std::vector<LtQuery> qs(kPoints);
+  for (int i = 0; i < kPoints; ++i) {
+    const Shading& x = pts[size_t(i)];
+    // N is a random unit vector: the segment's direction
+    qs[size_t(i)] = state.range(1) == 0 ? lt_query_point(x.P, x.N)
+                                        : lt_query_segment(x.P, x.N, 10.0f); // lights in 100^3
+  }
+  double cpu = 0;
+  long long picks = 0, sink = 0;
+  uint32_t round = 0;
+  for (auto _ : state) {
+    ++round;
+    double t0 = thread_cpu_seconds();
+    for (int k = 0; k < kPicks; ++k) {
+      LtRng rng = lt_rng_make(round, uint32_t(k));
+      float pmf;
+      sink += pick_one_q(&ls, &qs[size_t(k) & (kPoints - 1)], &rng, &pmf) + (pmf > 0.5f);
+    }
+    cpu += thread_cpu_seconds() - t0;
+    picks += kPicks;
+  }
+  benchmark::DoNotOptimize(sink);
+  state.SetLabel(state.range(1) == 0 ? "tree, point query" : "tree, segment query");
+  state.counters["cpu_ns_per_pick"] = 1e9 * cpu / double(picks);
+}
+
 const char* kDevicePickKernel = R"CL(
 #include "kernels/params.h"
 __kernel void pick_bench(LIGHT_SAMPLER_PARAMS __global const float4* P, __global const float4* N,
@@ -310,6 +354,11 @@ BENCHMARK(BM_SplitCut)
 BENCHMARK(BM_PickCpu)
     ->Name("PickCpu")
     ->Apply(pick_args)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
+BENCHMARK(BM_PickCpuQuery)
+    ->Name("PickCpuQuery")
+    ->ArgsProduct({{10000, 1000000}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
 BENCHMARK(BM_DevicePick)

@@ -15,6 +15,7 @@
 #include "integrator/brdf_mis.h"
 #include "integrator/light_pick.h"
 #include "integrator/shade_surface.h"
+#include "integrator/shade_volume.h"
 #include "render/camera.h"
 #include "render/device_scene.h"
 #include "render/features.h"
@@ -113,8 +114,17 @@ protected:
       materials_.push_back(m.gpu);
     geometry_ = build_scene_geometry(scene_, materials_);
     // "<sampler>-noorient": the orientation ablation (importance E / d^2); "brdf-mis-equal":
-    // brdf-mis with equal allocation (BrdfSettings::adaptive = false)
+    // brdf-mis with equal allocation (BrdfSettings::adaptive = false); "-medium": the room half
+    // filled with a coloured, forward-scattering medium (shade_volume and segment light picks)
     std::string name = GetParam();
+    if (name.ends_with("-medium")) {
+      name.resize(name.size() - 7);
+      scene_.has_medium = true;
+      scene_.medium.sigma_t = make_float4(0.35f, 0.5f, 0.7f, 0.4f);
+      scene_.medium.sigma_s = make_float4(0.3f, 0.4f, 0.5f, 1.0f);
+      scene_.medium.bmin = make_float4(-3.5f, -0.5f, -3.5f, 0.0f);
+      scene_.medium.bmax = make_float4(3.5f, 1.6f, 0.5f, 0.0f);
+    }
     const std::string suffix = "-noorient", equal = "-equal";
     bool orientation = !name.ends_with(suffix);
     if (!orientation) name.resize(name.size() - suffix.size());
@@ -157,6 +167,9 @@ protected:
       p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
       p.brdf_state.push_back(make_int4(0, 0, 0, 0));
       p.brdf_share.push_back(0.0f);
+      p.seg_o.push_back(make_float4(0, 0, 0, -1));
+      p.seg_d.push_back(make_float4(0, 0, 0, 0));
+      p.seg_beta.push_back(make_float4(0, 0, 0, 0));
     }
     return p;
   }
@@ -179,12 +192,13 @@ protected:
   void check_brdf_rounds(KernelArgs& args, const LightSamplerCtx& ls, const SceneBuffers& sc,
                          Paths& ref, const std::vector<int>& queue);
   void upload_scene() {
-    dev_ = upload_device_scene(rt_.context(), geometry_, materials_, scene_.lights, sampler_);
+    dev_ = upload_device_scene(rt_.context(), geometry_, materials_, scene_.lights, sampler_, 0,
+                               scene_.medium);
   }
   SceneBuffers host_scene() {
-    return SceneBuffers{geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
-                        geometry_.prims.data(), materials_.data(),
-                        geometry_.shading_normals.data()};
+    return SceneBuffers{geometry_.bvh.nodes.data(),       geometry_.bvh.prim_index.data(),
+                        geometry_.prims.data(),           materials_.data(),
+                        geometry_.shading_normals.data(), &scene_.medium};
   }
 
   ClRuntime rt_;
@@ -233,11 +247,44 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     hits += h.prim >= 0;
   ASSERT_GT(hits, kPaths * 9 / 10);
 
+  int segments_seen = 0, scattered_seen = 0;
   for (int depth : {0, 1, 2}) {
     SCOPED_TRACE("depth " + std::to_string(depth));
-    // ---- shade_surface: device
     KernelArgs args;
     dev_.set_args(args);
+    if (scene_.has_medium) { // ---- shade_volume: device, host, then both continue from the host's
+      upload(paths, args);
+      args.set("brdf_cut", to_device(rt_, host_cut_));
+      args.set("max_depth", cl_int(3));
+      cl::Buffer b_vc = to_device(rt_, std::vector<int>(2, 0));
+      args.set("volume_counters", b_vc);
+      BoundKernel kv(program_, "shade_volume", args);
+      enqueue_1d(rt_.queue(),
+                 kv.bind({{"depth", depth}, {"queue", to_device(rt_, queue)}, {"count", kPaths}}),
+                 kPaths);
+      Paths dev = download(args);
+      PathBuffers pbv = paths.host();
+      int segments = 0;
+      for (int i = 0; i < kPaths; ++i)
+        segments += shade_volume_item(queue[size_t(i)], depth, 3, &sc, &pbv, &ls);
+      EXPECT_EQ(from_device<int>(rt_, b_vc, 1)[0], segments);
+      compare_paths(dev, paths, queue);
+      for (int path : queue) {
+        size_t p = size_t(path);
+        std::string at = "path " + std::to_string(path);
+        expect_close4(dev.seg_o[p], paths.seg_o[p], at + " seg_o");
+        expect_close4(dev.seg_d[p], paths.seg_d[p], at + " seg_d");
+        expect_close4(make_float4(dev.seg_beta[p].x, dev.seg_beta[p].y, dev.seg_beta[p].z, 0),
+                      make_float4(paths.seg_beta[p].x, paths.seg_beta[p].y, paths.seg_beta[p].z, 0),
+                      at + " seg_beta");
+        ASSERT_EQ(float_as_uint_(dev.seg_beta[p].w), float_as_uint_(paths.seg_beta[p].w)) << at;
+        ASSERT_EQ(dev.hits[p].prim, paths.hits[p].prim) << at;
+        scattered_seen += paths.hits[p].prim == HIT_SCATTERED;
+      }
+      segments_seen += segments;
+      if (HasFailure()) return;
+    }
+    // ---- shade_surface: device
     upload(paths, args);
     // Every kernel with the light sampler's parameters takes the BRDF cut storage (read by the
     // brdf-mis / brdf-oriented stages only; check_brdf_cut fills it).
@@ -255,8 +302,12 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     Paths ref = paths;
     PathBuffers pb = ref.host();
     std::vector<int2> ref_counts(kPaths);
-    for (int i = 0; i < kPaths; ++i)
+    for (int i = 0; i < kPaths; ++i) {
       ref_counts[size_t(i)] = shade_surface_item(queue[size_t(i)], depth, 3, &sc, &pb, &ls);
+      if (scene_.has_medium)
+        ref_counts[size_t(i)] =
+            shade_counts_with_volume(ref_counts[size_t(i)], queue[size_t(i)], &pb);
+    }
     int continues = 0, shaded = 0, emission_hits = 0;
     for (int i = 0; i < kPaths; ++i) {
       ASSERT_EQ(dev_counts[size_t(i)].x, ref_counts[size_t(i)].x) << "item " << i;
@@ -267,16 +318,23 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
                        geometry_.prims[size_t(paths.hits[size_t(i)].prim)].light >= 0;
     }
     compare_paths(dev, ref, queue);
-    EXPECT_GT(shaded, kPaths / 2);
+    EXPECT_GT(shaded, scene_.has_medium ? kPaths / 4 : kPaths / 2);
     EXPECT_GT(emission_hits, 0); // the MIS-weighted emission path is exercised
     if (depth == 2) {
       EXPECT_LT(continues, shaded); // Russian roulette ends some paths
     }
 
     // ---- light_pick passes on the shaded points: device and host, pass by pass
+    // The roots as scatter_shade writes them: a path's segment root first, then its surface point's
     std::vector<SplitItem> items;
-    for (int i = 0; i < kPaths; ++i)
-      if (ref_counts[size_t(i)].y) items.push_back(light_sampler_root(&ls, queue[size_t(i)]));
+    for (int i = 0; i < kPaths; ++i) {
+      int path = queue[size_t(i)], roots = ref_counts[size_t(i)].y;
+      if (scene_.has_medium && ref.seg_o[size_t(path)].w >= 0.0f) {
+        items.push_back(light_sampler_root(&ls, path | SPLIT_SEGMENT));
+        roots -= 1;
+      }
+      if (roots) items.push_back(light_sampler_root(&ls, path));
+    }
     upload(ref, args); // the shaded state as the next stage sees it
     PathBuffers pb2 = ref.host();
     if (sampler_.brdf_oriented()) {
@@ -288,7 +346,8 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       ASSERT_LT(passes, 40);
       size_t n = items.size();
       cl::Buffer b_child(rt_.context(), CL_MEM_READ_WRITE, 4 * n * sizeof(SplitItem));
-      cl::Buffer b_shadow(rt_.context(), CL_MEM_READ_WRITE, 4 * n * sizeof(ShadowItem));
+      const size_t slots = LIGHT_PICK_SHADOW_SLOTS; // the program has every feature (media too)
+      cl::Buffer b_shadow(rt_.context(), CL_MEM_READ_WRITE, slots * n * sizeof(ShadowItem));
       cl::Buffer b_pc(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2));
       std::vector<int> zeros(kPaths, 0);
       cl::Buffer b_cut = to_device(rt_, zeros);
@@ -296,20 +355,21 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       args.set("shadow_stage", b_shadow);
       args.set("counts_pick", b_pc);
       args.set("cut_size", b_cut);
+      args.set("volume_counters", to_device(rt_, std::vector<int>(2, 0)));
       BoundKernel kp(program_, "light_pick", args);
       enqueue_1d(rt_.queue(), kp.bind({{"split_in", to_device(rt_, items)}, {"count", int(n)}}), n);
       std::vector<int2> dc = from_device<int2>(rt_, b_pc, n);
       std::vector<SplitItem> dchild = from_device<SplitItem>(rt_, b_child, 4 * n);
-      std::vector<ShadowItem> dshadow = from_device<ShadowItem>(rt_, b_shadow, 4 * n);
+      std::vector<ShadowItem> dshadow = from_device<ShadowItem>(rt_, b_shadow, slots * n);
       std::vector<int> dcut = from_device<int>(rt_, b_cut, kPaths);
 
       std::vector<SplitItem> hchild(4 * n);
-      std::vector<ShadowItem> hshadow(4 * n);
+      std::vector<ShadowItem> hshadow(slots * n);
       std::vector<int> hcut(kPaths, 0);
       std::vector<SplitItem> next;
       for (size_t i = 0; i < n; ++i) {
-        int4 r = light_pick_item(items[i], &ls, &sc, &pb2, &hchild[4 * i], &hshadow[4 * i]);
-        hcut[size_t(items[i].path)] += r.z;
+        int4 r = light_pick_item(items[i], &ls, &sc, &pb2, &hchild[4 * i], &hshadow[slots * i]);
+        hcut[size_t(items[i].path & ~SPLIT_SEGMENT)] += r.z;
         ASSERT_EQ(dc[i].x, r.x) << "pass " << passes << " item " << i;
         ASSERT_EQ(dc[i].y, r.y) << "pass " << passes << " item " << i;
         for (int j = 0; j < r.x; ++j) {
@@ -321,7 +381,7 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
           next.push_back(y);
         }
         for (int j = 0; j < r.y; ++j) {
-          const ShadowItem &x = dshadow[4 * i + size_t(j)], &y = hshadow[4 * i + size_t(j)];
+          const ShadowItem &x = dshadow[slots * i + size_t(j)], &y = hshadow[slots * i + size_t(j)];
           expect_close4(x.origin, y.origin, "shadow origin");
           expect_close(x.dir.x, y.dir.x, "shadow dir");
           EXPECT_EQ(float_as_uint_(x.dir.w), float_as_uint_(y.dir.w)) << "shadow path";
@@ -348,6 +408,10 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
                     geometry_.prims.data(), xyz_of(paths.ray_o[i]), xyz_of(paths.ray_d[i]),
                     paths.ray_o[i].w, FLT_INF, 0, &paths.hits[i]);
+  }
+  if (scene_.has_medium) { // segments got light picks and paths scattered in the medium
+    EXPECT_GT(segments_seen, kPaths / 4);
+    EXPECT_GT(scattered_seen, kPaths / 50);
   }
 }
 
@@ -539,7 +603,8 @@ void KernelStages::check_brdf_rounds(KernelArgs& args, const LightSamplerCtx& ls
 INSTANTIATE_TEST_SUITE_P(Samplers, KernelStages,
                          ::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive",
                                            "tree-noorient", "tree-split-noorient", "brdf-mis",
-                                           "brdf-mis-equal", "brdf-oriented"),
+                                           "brdf-mis-equal", "brdf-oriented", "power-medium",
+                                           "tree-medium", "tree-split-medium", "brdf-mis-medium"),
                          [](const auto& p) {
                            std::string s = p.param;
                            for (char& c : s)

@@ -70,7 +70,29 @@ TEST_P(RenderFeatures, MinimalFeatureSetRendersTheSameImageAsEveryFeature) {
       << minimal_opts;
   EXPECT_NE(all_opts.find("-DHAS_MATERIAL_CONDUCTOR=1 -DHAS_MATERIAL_PLASTIC=1"), std::string::npos)
       << all_opts;
+  // no medium code (shade_volume, segment picks) for a scene without a medium
+  EXPECT_NE(minimal_opts.find("-DHAS_MEDIUM=0"), std::string::npos) << minimal_opts;
+  EXPECT_NE(all_opts.find("-DHAS_MEDIUM=1"), std::string::npos) << all_opts;
   expect_identical(minimal, all);
+}
+
+TEST_P(RenderFeatures, SceneWithMediumRendersTheSameImageWithEveryFeature) {
+  // The default scene with a coloured, forward-scattering medium filling its lower half: the
+  // minimal build has the medium but no sphere, point or disk code.
+  Scene scene = small_default_scene();
+  scene.has_medium = true;
+  scene.medium.sigma_t = make_float4(0.5f, 0.6f, 0.8f, 0.3f);
+  scene.medium.sigma_s = make_float4(0.4f, 0.5f, 0.6f, 1.0f);
+  scene.medium.bmin = make_float4(-5, -1, -5, 0);
+  scene.medium.bmax = make_float4(5, 1, 5, 0);
+  std::string minimal_opts;
+  Film minimal = render(scene, GetParam(), false, 1 << 18, &minimal_opts);
+  Film all = render(scene, GetParam(), true, 1 << 18);
+  EXPECT_NE(minimal_opts.find("-DHAS_MEDIUM=1"), std::string::npos) << minimal_opts;
+  EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_SPHERE=0"), std::string::npos) << minimal_opts;
+  expect_identical(minimal, all);
+  Film waves = render(scene, GetParam(), false, 777); // many small waves
+  expect_identical(minimal, waves);
 }
 
 TEST_P(RenderFeatures, SceneWithGlossyMaterialsRendersTheSameImageWithEveryFeature) {

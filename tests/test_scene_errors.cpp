@@ -1027,3 +1027,34 @@ TEST(SceneErrors, MtlFifoIsRefusedWithoutBlocking) {
                "a regular file)");
   std::filesystem::remove(fifo);
 }
+
+// --------------------------------------------------------------------------------- medium
+
+TEST(SceneErrors, MediumValues) {
+  auto medium = [](const std::string& body) {
+    return error_of(scene_with(R"("medium": {)" + body + "}"));
+  };
+  EXPECT_EQ(medium(R"("sigma_s": 0.1)"), "scene.json: medium.sigma_a: required key is missing");
+  EXPECT_EQ(medium(R"("sigma_a": -0.1, "sigma_s": 0.1)"),
+            "scene.json: medium.sigma_a: must be in [0, 1e+20]");
+  EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": [0.1, -1, 0])"),
+            "scene.json: medium.sigma_s[1]: must be in [0, 1e+20]");
+  EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": 1e21)"),
+            "scene.json: medium.sigma_s: must be in [0, 1e+20]");
+  EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": 0.1, "g": 1)"),
+            "scene.json: medium.g: must be in (-1, 1)");
+  EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": 0.1, "density": 1)"),
+            "scene.json: medium.density: unknown key");
+  EXPECT_EQ(
+      medium(R"("sigma_a": 0, "sigma_s": 0.1, "bounds": {"min": [0, 0, 0], "max": [1, 0, 1]})"),
+      "scene.json: medium.bounds.max: must exceed bounds.min in every coordinate");
+  EXPECT_EQ(medium(R"("sigma_a": 0, "sigma_s": 0.1, "bounds": {"min": [0, 0, 0]})"),
+            "scene.json: medium.bounds.max: required key is missing");
+  EXPECT_EQ(
+      medium(R"("sigma_a": 0, "sigma_s": 0.1, "bounds": {"min": [0, 0, 0], "max": [1e19, 1, 1]})")
+          .rfind("scene.json: medium.bounds.max: ", 0),
+      0u);
+  EXPECT_EQ(error_of(scene_with(R"("integrator": {"volume_importance": "centre"})")),
+            "scene.json: integrator.volume_importance: unknown value \"centre\" (expected one of: "
+            "segment, midpoint)");
+}

@@ -501,3 +501,31 @@ TEST(SceneLoader, SceneFileRelativePaths) {
   EXPECT_EQ(s.triangle_count(), 4u);
   EXPECT_EQ(s.lights.size(), 2u);
 }
+
+TEST(SceneLoader, Medium) {
+  const std::string head = R"({"camera": {"position": [0, 1, 5], "look_at": [0, 0, 0]},
+    "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}], )";
+  Scene s = load_str(head + R"("medium": {"sigma_a": [0.1, 0.2, 0.3], "sigma_s": 0.5, "g": -0.4,
+    "bounds": {"min": [-1, -2, -3], "max": [1, 2, 3]}}})");
+  ASSERT_TRUE(s.has_medium);
+  EXPECT_FLOAT_EQ(s.medium.sigma_t.x, 0.6f); // sigma_a + sigma_s
+  EXPECT_FLOAT_EQ(s.medium.sigma_t.y, 0.7f);
+  EXPECT_FLOAT_EQ(s.medium.sigma_t.z, 0.8f);
+  EXPECT_FLOAT_EQ(s.medium.sigma_t.w, -0.4f); // g
+  EXPECT_FLOAT_EQ(s.medium.sigma_s.y, 0.5f);
+  EXPECT_EQ(s.medium.sigma_s.w, 1.0f); // bounded
+  EXPECT_FLOAT_EQ(s.medium.bmin.z, -3.0f);
+  EXPECT_FLOAT_EQ(s.medium.bmax.y, 2.0f);
+  EXPECT_EQ(s.integrator.volume_importance, "segment");
+
+  Scene u = load_str(head + R"("medium": {"sigma_a": 0, "sigma_s": [0, 0.1, 0]},
+    "integrator": {"volume_importance": "midpoint"}})");
+  ASSERT_TRUE(u.has_medium);
+  EXPECT_EQ(u.medium.sigma_s.w, 0.0f);       // fills all space
+  EXPECT_FLOAT_EQ(u.medium.sigma_t.w, 0.0f); // g defaults to isotropic
+  EXPECT_EQ(u.integrator.volume_importance, "midpoint");
+
+  // sigma_t = 0: vacuum, no medium at all
+  EXPECT_FALSE(load_str(head + R"("medium": {"sigma_a": 0, "sigma_s": 0}})").has_medium);
+  EXPECT_FALSE(load_str(head.substr(0, head.size() - 2) + "}").has_medium);
+}

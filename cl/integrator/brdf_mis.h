@@ -247,6 +247,7 @@ INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls,
   float3 err;
   float3 y = primitive_hit_point(prim, o, d, h, &err);
   float3 Le = light_emitted_radiance(&ls->lights[light], primitive_normal(prim, y), -d);
+  if (HAS_MEDIUM) Le = Le * volume_transmittance(sc, o, d, h.t); // attenuated on its way
   if (!(max3(Le) > 0.0f)) {
     item->value = zero;
     return;

@@ -11,6 +11,11 @@
 #include "light_point.h"
 #include "light_sampler.h"
 #include "path_state.h"
+#include "volume_light.h"
+
+// Shadow-item slots per split item: a split leaf stages one item per emitter (up to 4), two per
+// emitter for a medium segment (equiangular and free-flight points).
+#define LIGHT_PICK_SHADOW_SLOTS (HAS_MEDIUM ? 8 : 4)
 
 // Samples a point on `light` (chosen with probability pmf) from the path's shading point and, if
 // it can contribute, writes the shadow item. Returns 1 if an item was written.
@@ -45,30 +50,47 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   return 1;
 }
 
-// Processes one split item. Stages up to 4 child items in children[0..3] or up to 4 shadow items
-// in shadows[0..3]. Returns (children staged, shadow items staged, lights in the cut, 0).
+// The shadow items of `light`, picked with probability pmf for the item's context: one for a
+// shading point, up to two for a medium segment (volume_light.h).
+INLINE int light_pick_items(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                            const PathBuffers* pb, int path, int segment, int light, float pmf,
+                            LtRng* rng, GLOBAL ShadowItem* out) {
+  if (HAS_MEDIUM && segment) return volume_shadow_items(ls, sc, pb, path, light, pmf, rng, out);
+  return light_pick_shadow_item(ls, sc, pb, path, light, pmf, rng, out);
+}
+
+// Processes one split item: a cluster for a path's shading point or (SPLIT_SEGMENT) for its
+// medium segment. Stages up to 4 child items in children[0..3] or up to LIGHT_PICK_SHADOW_SLOTS
+// shadow items in shadows[]. Returns (children staged, shadow items staged, lights in the cut, 0).
 INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const SceneBuffers* sc,
                             const PathBuffers* pb, GLOBAL SplitItem* children,
                             GLOBAL ShadowItem* shadows) {
   int4 out = make_int4(0, 0, 0, 0);
-  int path = it.path;
-  float3 P = xyz_of(pb->shade_P[path]);
-  float3 N = xyz_of(pb->shade_N[path]);
-  uint seed = float_as_uint_(pb->shade_N[path].w);
+  int segment = HAS_MEDIUM && (it.path & SPLIT_SEGMENT) != 0;
+  int path = it.path & ~SPLIT_SEGMENT;
+  LtQuery q;
+  uint seed;
+  if (HAS_MEDIUM && segment) {
+    q = volume_query(pb, path);
+    seed = float_as_uint_(pb->seg_beta[path].w);
+  } else {
+    q = lt_query_point(xyz_of(pb->shade_P[path]), xyz_of(pb->shade_N[path]));
+    seed = float_as_uint_(pb->shade_N[path].w);
+  }
   const LtTree* t = &ls->tree;
 
   if (light_sampler_splits(ls) &&
-      lt_item_splits(t, it.sphere, it.cv2, it.code, it.budget, P, ls->threshold)) {
-    float4 imp = lt_code_importance(t, it.code, P, N);
+      lt_item_splits_q(t, it.sphere, it.cv2, it.code, it.budget, &q, ls->threshold)) {
+    float4 imp = lt_code_importance_q(t, it.code, &q);
     if (it.code >= 0) { // interior node: its contributing lanes go to the next pass
       int4 ch = t->children[it.code];
-      int4 budgets = lt_child_budgets(t, it.code, imp, it.budget, P, ls->threshold);
+      int4 budgets = lt_child_budgets_q(t, it.code, imp, it.budget, &q, ls->threshold);
       for (int lane = 0; lane < 4; ++lane) {
         int code = i4_get(ch, lane);
         if (code == LT_EMPTY || !(f4_get(imp, lane) > 0.0f)) continue;
         SplitItem c;
         c.sphere = lt_lane_sphere(t, it.code, lane);
-        c.path = path;
+        c.path = it.path;
         c.code = code;
         c.budget = (uint)i4_get(budgets, lane);
         c.cv2 = lt_lane_cv2(t, it.code, lane);
@@ -83,7 +105,7 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
       int light = t->leaf_lights[first + j];
       LtRng rng = lt_rng_make(seed, 0x80000000u ^ (uint)light);
       out.z += 1;
-      out.y += light_pick_shadow_item(ls, sc, pb, path, light, 1.0f, &rng, &shadows[out.y]);
+      out.y += light_pick_items(ls, sc, pb, path, segment, light, 1.0f, &rng, &shadows[out.y]);
     }
     return out;
   }
@@ -91,9 +113,10 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
   // One stochastic pick below the item (codes are unique within a cut: one stream each).
   LtRng rng = lt_rng_make(seed, (uint)it.code);
   float pmf;
-  int light = light_sampler_pick(ls, it.code, P, N, &rng, &pmf);
+  int light = light_sampler_pick_q(ls, it.code, &q, &rng, &pmf);
   out.z = 1;
-  if (light >= 0) out.y = light_pick_shadow_item(ls, sc, pb, path, light, pmf, &rng, &shadows[0]);
+  if (light >= 0)
+    out.y = light_pick_items(ls, sc, pb, path, segment, light, pmf, &rng, &shadows[0]);
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include "../shading.h"
 #include "light_sampler.h"
 #include "path_state.h"
+#include "volume_light.h"
 
 // A light point sampled for the shading point of `path` from `light` and what it brings: the
 // unoccluded radiance times the BRDF and cosine, the BSDF's pdf for the direction, and the shadow
@@ -51,6 +52,8 @@ INLINE int light_point_sample(const LightSamplerCtx* ls, const SceneBuffers* sc,
   float dist = length(to);
   if (!(dist > 0.0f)) return 0;
   float tmax = dist - fp_gamma(6) * (max_abs3(s.x) + dist);
+  // Light crossing the medium on its way is attenuated (volume_light.h).
+  if (HAS_MEDIUM) s.Li = s.Li * volume_transmittance(sc, P, to / dist, fmax(tmax, 0.0f));
   lp->origin = f4_from3(P, fmax(tmax, 0.0f));
   lp->dir = f4_from3(to / dist, uint_as_float_((uint)path));
   lp->s = s;

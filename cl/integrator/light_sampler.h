@@ -7,6 +7,7 @@
 #define CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 
 #include "../light_tree/pmf.h"
+#include "../light_tree/query.h"
 #include "../light_tree/traverse.h"
 #include "../types.h"
 
@@ -41,12 +42,13 @@ INLINE SplitItem light_sampler_root(const LightSamplerCtx* ls, int path) {
   return it;
 }
 
-// Picks one light among all of them (uniform, power) or below `code` (tree) with random words
-// from rng, each choice with exactly the probability it reports (cl/light_tree/rng.h, "exact
-// discrete choices"). Returns the light or -1; *pmf its probability. The host samplers
-// (host/lighttree/light_sampler.cpp) run the same functions.
-INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, float3 N, LtRng* rng,
-                              float* pmf) {
+// Picks one light among all of them (uniform, power) or below `code` (tree) for query q (a
+// shading point or a ray segment in a medium, cl/light_tree/query.h) with random words from rng,
+// each choice with exactly the probability it reports (cl/light_tree/rng.h, "exact discrete
+// choices"). Returns the light or -1; *pmf its probability. uniform and power ignore q. The host
+// samplers (host/lighttree/light_sampler.cpp) run the same functions.
+INLINE int light_sampler_pick_q(const LightSamplerCtx* ls, int code, const LtQuery* q, LtRng* rng,
+                                float* pmf) {
   *pmf = 0.0f;
   if (ls->light_count <= 0 || ls->kind == SAMPLER_BSDF) return -1;
   if (ls->kind == SAMPLER_UNIFORM) {
@@ -58,18 +60,28 @@ INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, flo
     *pmf = ls->power_pmf[l];
     return *pmf > 0.0f ? l : -1;
   }
-  return lt_pick_below(&ls->tree, code, P, N, rng, pmf);
+  return lt_pick_below_q(&ls->tree, code, q, rng, pmf);
+}
+INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, float3 N, LtRng* rng,
+                              float* pmf) {
+  LtQuery q = lt_query_point(P, N);
+  return light_sampler_pick_q(ls, code, &q, rng, pmf);
 }
 
-// Probability that the technique produces `light` at (P, N): for MIS when a BSDF ray hits it.
-// With splitting it is the product of the lane probabilities below the item where splitting
-// stopped (DESIGN §4), recomputed along the light's bit-trail with the same functions.
-INLINE float light_sampler_pmf(const LightSamplerCtx* ls, float3 P, float3 N, int light) {
+// Probability that the technique produces `light` for query q: for MIS when a BSDF ray (or, in a
+// medium, a phase-function ray) hits it. With splitting it is the product of the lane
+// probabilities below the item where splitting stopped (DESIGN §4), recomputed along the light's
+// bit-trail with the same functions.
+INLINE float light_sampler_pmf_q(const LightSamplerCtx* ls, const LtQuery* q, int light) {
   if (ls->light_count <= 0 || ls->kind == SAMPLER_BSDF) return 0.0f;
   if (ls->kind == SAMPLER_UNIFORM) return 1.0f / (float)ls->light_count;
   if (ls->kind == SAMPLER_POWER) return ls->power_pmf[light];
-  if (ls->kind == SAMPLER_TREE) return lt_pmf_below(&ls->tree, 0, P, N, ls->tree.trails[light]);
-  return lt_pmf_split(&ls->tree, P, N, light, ls->threshold, ls->max_cut);
+  if (ls->kind == SAMPLER_TREE) return lt_pmf_below_q(&ls->tree, 0, q, ls->tree.trails[light]);
+  return lt_pmf_split_q(&ls->tree, q, light, ls->threshold, ls->max_cut);
+}
+INLINE float light_sampler_pmf(const LightSamplerCtx* ls, float3 P, float3 N, int light) {
+  LtQuery q = lt_query_point(P, N);
+  return light_sampler_pmf_q(ls, &q, light);
 }
 
 // brdf-mis and brdf-oriented are tree-split at points without a glossy BRDF.

@@ -35,7 +35,14 @@
   /* point whose cut is not built yet), z: samples drawn, w: n_hit | n_nohit << 16 (Alg. 1) */     \
   X(int4, brdf_state)                                                                              \
   /* brdf-mis: the share of BRDF-oriented light samples the tree sample's MIS weight assumes */    \
-  X(float, brdf_share)
+  X(float, brdf_share)                                                                             \
+  /* With a medium (shade_volume.h): this bounce's ray segment inside the medium. xyz: its start */ \
+  /* (where the ray enters the medium), w: its length, < 0 when it gets no light samples */          \
+  X(float4, seg_o)                                                                                 \
+  /* xyz: its unit direction, w: the free-flight distance sampled along it (from its start) */     \
+  X(float4, seg_d)                                                                                 \
+  /* xyz: the path throughput at its start, w: the segment's light-pick seed (uint bits) */        \
+  X(float4, seg_beta)
 
 // The scene's buffers, likewise: X(element type, name), read-only on the device.
 #define SCENE_BUFFERS(X)                                                                           \
@@ -44,7 +51,9 @@
   X(Primitive, prims)                                                                              \
   X(Material, materials)                                                                           \
   /* three unit vertex normals per smooth triangle (Primitive.normals, cl/geometry.h) */            \
-  X(float4, shading_normals)
+  X(float4, shading_normals)                                                                       \
+  /* the scene's participating medium (one record; zeros without one) */                          \
+  X(Medium, medium)
 // clang-format on
 
 #define CANOPY_PATH_FIELD(T, name) GLOBAL T* name;

@@ -26,6 +26,8 @@ INLINE float shade_emission_weight(const LightSamplerCtx* ls, const PathBuffers*
                                    int depth, int light, float3 P) {
   float4 prev_P = pb->shade_P[path];
   if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
+  // A medium vertex has its direct light complete without its phase-function ray (volume_light.h)
+  if (HAS_MEDIUM && pb->shade_f[path].w == VOLUME_POINT_FLAG) return 0.0f;
   // A glossy point of a BRDF sampler has its direct light complete without its bounce (brdf_mis.h)
   if (HAS_MICROFACET && light_sampler_brdf(ls) && pb->shade_f[path].w == BRDF_POINT_FLAG)
     return 0.0f;
@@ -40,7 +42,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
                                const PathBuffers* pb, const LightSamplerCtx* ls) {
   int2 out = make_int2(0, 0);
   Hit h = pb->hits[path];
-  if (h.prim < 0) { // escaped: no environment light
+  if (h.prim < 0) { // escaped (no environment light), or scattered in the medium (shade_volume.h)
     // and no glossy point: brdf_sample must not act on a stale (or never written) brdf_state
     if (HAS_MICROFACET && light_sampler_brdf(ls)) pb->brdf_state[path] = make_int4(0, 0, 0, 0);
     return out;

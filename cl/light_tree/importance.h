@@ -8,6 +8,7 @@
 #include "../compat.h"
 #include "../simd4.h"
 #include "layout.h"
+#include "query.h"
 
 // Smallest importance given to a lane that can contribute, so underflow never makes it 0 (the
 // importances of the four lanes are normalised by their maximum energy and minimum distance first).
@@ -42,7 +43,23 @@ typedef struct LtView {
   v4m inside, front;
 } LtView;
 
-// All angle differences use cos(a-b) = cos a cos b + sin a sin b (no acos).
+// The orientation bound of Eq. 3 and Eq. 7: cos(theta') = cos(max(theta - theta_o - theta_u, 0)),
+// 0 when theta' >= theta_e, from (cos, sin) of theta (the smallest angle between the cone axis and
+// the directions from the cluster towards the receiver) and of theta_u. All angle differences use
+// cos(a-b) = cos a cos b + sin a sin b (no acos).
+LT_HOT v4f lt_orient_v(const LtLanes* l, v4f cos_t, v4f sin_t, v4f cos_u, v4f sin_u) {
+  v4f zero = v4_splat(0.0f);
+  v4f one = v4_splat(1.0f);
+  v4f sin_o = v4_sqrt(v4_max(v4_sub(one, v4_mul(l->cos_o, l->cos_o)), zero));
+  // theta - theta_o, clamped at 0
+  v4m within_o = v4_ge(cos_t, l->cos_o);
+  v4f c1 = v4_sel(v4_add(v4_mul(cos_t, l->cos_o), v4_mul(sin_t, sin_o)), one, within_o);
+  v4f s1 = v4_sel(v4_sub(v4_mul(sin_t, l->cos_o), v4_mul(cos_t, sin_o)), zero, within_o);
+  // minus theta_u, clamped at 0
+  v4f c2 = v4_sel(v4_add(v4_mul(c1, cos_u), v4_mul(s1, sin_u)), one, v4_ge(c1, cos_u));
+  return v4_sel(zero, c2, v4_gt(c2, l->cos_e));
+}
+
 LT_HOT LtView lt_view_v(const LtLanes* l, float3 P) {
   LtView v;
   v4f zero = v4_splat(0.0f);
@@ -80,14 +97,7 @@ LT_HOT LtView lt_view_v(const LtLanes* l, float3 P) {
   v.front =
       v4_gt(cos_t, v4_sub(zero, v4_add(v4_mul(l->plane_h, v.inv_d), v4_splat(LT_PLANE_SLOPE))));
   v4f sin_t = v4_min(v4_mul(lt_vcross_len(l->ax, l->ay, l->az, v.dx, v.dy, v.dz), v.inv_d), one);
-  v4f sin_o = v4_sqrt(v4_max(v4_sub(one, v4_mul(l->cos_o, l->cos_o)), zero));
-  // theta - theta_o, clamped at 0
-  v4m within_o = v4_ge(cos_t, l->cos_o);
-  v4f c1 = v4_sel(v4_add(v4_mul(cos_t, l->cos_o), v4_mul(sin_t, sin_o)), one, within_o);
-  v4f s1 = v4_sel(v4_sub(v4_mul(sin_t, l->cos_o), v4_mul(cos_t, sin_o)), zero, within_o);
-  // minus theta_u, clamped at 0
-  v4f c2 = v4_sel(v4_add(v4_mul(c1, v.cos_u), v4_mul(s1, v.sin_u)), one, v4_ge(c1, v.cos_u));
-  v.orient = v4_sel(zero, c2, v4_gt(c2, l->cos_e));
+  v.orient = lt_orient_v(l, cos_t, sin_t, v.cos_u, v.sin_u);
   return v;
 }
 
@@ -134,6 +144,124 @@ LT_HOT v4f lt_importance_v(const LtLanes* l, float3 P, float3 N, int fallback) {
     res = v4_sel(zero, v4_max(v4_mul(e, g), v4_splat(LT_IMPORTANCE_FLOOR)), alive);
   return res;
 }
+// ---------------------------------------------------------------- segment importance (§5.2, Eq. 7)
+// Importance of four clusters for the ray segment x(t) = a + t d, t in [0, len] (a = q->P, unit
+// d = q->N) in a medium, whose direct light is integrated along the segment (equiangular sampling):
+// what remains of a light's 1/x^2 after that integral is (theta_b - theta_a) / D (Eq. 4), so the
+// falloff is 1/d_min. Per lane (Eq. 7):
+//   E * cos(max(theta_min - theta_o - theta_u, 0)) / max(d_min, r/2)
+// (0 when that angle >= theta_e), d_min the distance from the centre c to the segment, theta_u the
+// sphere's half-angle seen from the closest point, theta_min the smallest angle between the cone
+// axis and a direction from c towards a point of the segment (Eq. 5-6). As the paper says, the
+// distance and the angle are bounded at different points of the segment: conservative. No receiver
+// cosine (a medium point has no normal). Normalisation, floor and `fallback` as lt_importance_v.
+//
+// theta_min: the directions from c to x(t) sweep the great-circle arc from v0 = (a - c)/|a - c| to
+// v1 = (b - c)/|b - c|. Eq. 5-6 maximise v . axis over the arc in the basis o0 = v0, o1 = v1
+// orthonormalised against v0, which is ill-conditioned for short segments (v0 ~ v1) and for c near
+// the segment's line. The same maximum in the basis (w/D, d), w = the vector from c to the foot of
+// the perpendicular on the line, D = |w|: x(s) - c = w + s d, s in [s_a, s_b] = [(a - c).d,
+// (a - c).d + len], and (w + s d).axis / |w + s d| is stationary at s* = D^2 (d.axis) / (w.axis),
+// the maximum over the whole line iff w.axis > 0, of value sqrt((w.axis)^2 + D^2 (d.axis)^2) / D
+// (Eq. 6's second case: phi0 within the arc); if w.axis <= 0 or s* is outside [s_a, s_b] (Eq. 6's
+// first case: o1.a < 0 or v0.v1 > cos phi0) the maximum is b_max, the larger endpoint cosine. Where
+// c is within D <= 1e-3 sqrt(s_a^2 + s_b^2) of the line with its foot on the segment, the direction
+// of w is rounding noise and cos theta_min = 1 (conservative: some plane through the line holds the
+// axis). A zero-length segment is a point (s_a = s_b).
+//
+// Half-space bound (one-sided planar lanes): dot(axis, x - c) + h + LT_PLANE_SLOPE |x - c| is
+// convex in x, so it is positive somewhere on the segment iff it is at an end: the lane is culled
+// only if both ends are behind.
+LT_HOT v4f lt_importance_seg_v(const LtLanes* l, const LtQuery* q, int fallback) {
+  v4f zero = v4_splat(0.0f);
+  v4f one = v4_splat(1.0f);
+  v4f dx = v4_splat(q->N.x), dy = v4_splat(q->N.y), dz = v4_splat(q->N.z);
+  v4f len = v4_splat(q->len);
+  // e = a - c, s_a = e.d, w = e - s_a d
+  v4f ex = v4_sub(v4_splat(q->P.x), l->cx);
+  v4f ey = v4_sub(v4_splat(q->P.y), l->cy);
+  v4f ez = v4_sub(v4_splat(q->P.z), l->cz);
+  v4f sa = v4_add(v4_add(v4_mul(ex, dx), v4_mul(ey, dy)), v4_mul(ez, dz));
+  v4f sb = v4_add(sa, len);
+  v4f wx = v4_sub(ex, v4_mul(sa, dx));
+  v4f wy = v4_sub(ey, v4_mul(sa, dy));
+  v4f wz = v4_sub(ez, v4_mul(sa, dz));
+  v4f D2 = v4_add(v4_add(v4_mul(wx, wx), v4_mul(wy, wy)), v4_mul(wz, wz));
+  // closest point: s = clamp(0, s_a, s_b)
+  v4f sc = v4_max(sa, v4_min(sb, zero));
+  v4f dist2 = v4_add(D2, v4_mul(sc, sc));
+  v4f r2 = v4_mul(l->r, l->r);
+  v4m inside = v4_le(dist2, r2);
+  v4f dist = v4_sqrt(dist2);
+  v4f inv_dist = v4_div(one, v4_max(dist, v4_splat(1e-18f)));
+  // theta_u from the closest point (pi inside the sphere)
+  v4f sin_u = v4_min(v4_mul(l->r, inv_dist), one);
+  v4f cos_u = v4_min(v4_mul(v4_sqrt(v4_max(v4_sub(dist2, r2), zero)), inv_dist), one);
+  sin_u = v4_sel(sin_u, zero, inside);
+  cos_u = v4_sel(cos_u, v4_splat(-1.0f), inside);
+  v4f orient;
+  v4m front = v4_le(l->cos_o, v4_splat(-1.0f)); // full-sphere lanes: no half-space bound
+  if (v4_all(front)) {
+    orient = v4_sel(zero, one, v4_gt(one, l->cos_e)); // theta' = 0, as in lt_view_v
+  } else {
+    v4f fx = v4_add(ex, v4_mul(len, dx)); // f = b - c
+    v4f fy = v4_add(ey, v4_mul(len, dy));
+    v4f fz = v4_add(ez, v4_mul(len, dz));
+    v4f la = v4_sqrt(v4_add(v4_add(v4_mul(ex, ex), v4_mul(ey, ey)), v4_mul(ez, ez)));
+    v4f lb = v4_sqrt(v4_add(v4_add(v4_mul(fx, fx), v4_mul(fy, fy)), v4_mul(fz, fz)));
+    v4f ea = v4_add(v4_add(v4_mul(ex, l->ax), v4_mul(ey, l->ay)), v4_mul(ez, l->az));
+    v4f fa = v4_add(v4_add(v4_mul(fx, l->ax), v4_mul(fy, l->ay)), v4_mul(fz, l->az));
+    v4f da = v4_add(v4_add(v4_mul(dx, l->ax), v4_mul(dy, l->ay)), v4_mul(dz, l->az));
+    v4f wa = v4_add(v4_add(v4_mul(wx, l->ax), v4_mul(wy, l->ay)), v4_mul(wz, l->az));
+    // half-space bound at either end: the larger margin dot(axis, x - c) + h + slope |x - c|
+    v4f slope = v4_splat(LT_PLANE_SLOPE);
+    v4f margin_a = v4_add(ea, v4_add(l->plane_h, v4_mul(slope, la)));
+    v4f margin_b = v4_add(fa, v4_add(l->plane_h, v4_mul(slope, lb)));
+    front = v4_gt(v4_max(margin_a, margin_b), zero);
+    // b_max: the endpoint cosines
+    v4f tiny = v4_splat(1e-30f);
+    v4f ca = v4_div(ea, v4_max(la, tiny));
+    v4f cb = v4_div(fa, v4_max(lb, tiny));
+    v4f cos_t = v4_max(ca, cb);
+    // the interior maximum (Eq. 6, second case) where s* = D^2 da / wa lies in [s_a, s_b]
+    v4f D2da = v4_mul(D2, da);
+    v4m interior =
+        v4_and(v4_gt(wa, zero), v4_and(v4_le(v4_mul(sa, wa), D2da), v4_le(D2da, v4_mul(sb, wa))));
+    v4f R = v4_mul(v4_sqrt(v4_add(v4_mul(wa, wa), v4_mul(D2da, da))),
+                   v4_div(one, v4_sqrt(v4_max(D2, v4_splat(1e-36f)))));
+    cos_t = v4_sel(cos_t, v4_min(R, one), interior);
+    // c (numerically) on the line, its foot on the segment: every direction of the plane
+    v4m on_line = v4_and(v4_le(D2, v4_mul(v4_splat(1e-6f), v4_add(v4_mul(sa, sa), v4_mul(sb, sb)))),
+                         v4_and(v4_le(sa, zero), v4_ge(sb, zero)));
+    cos_t = v4_sel(cos_t, one, on_line);
+    cos_t = v4_min(v4_max(cos_t, v4_splat(-1.0f)), one);
+    v4f sin_t = v4_sqrt(v4_max(v4_sub(one, v4_mul(cos_t, cos_t)), zero));
+    orient = lt_orient_v(l, cos_t, sin_t, cos_u, sin_u);
+  }
+  // falloff 1/d_min, d_min clamped at r/2 like Eq. 3's d; normalised by the largest energy and
+  // the smallest d_min among the lanes
+  v4f dc = v4_max(v4_max(dist, v4_mul(l->r, v4_splat(0.5f))), v4_splat(1e-18f));
+  v4m alive = v4_gt(l->energy, zero);
+  float emax = v4_hmax(l->energy);
+  float dmin = v4_hmin(v4_sel(v4_splat(3.0e38f), dc, alive));
+  float inv_emax = emax > 0.0f ? 1.0f / emax : 0.0f;
+  v4f e = v4_mul(l->energy, v4_splat(inv_emax));
+  v4f g = v4_div(v4_splat(dmin), dc);
+  v4f imp = v4_mul(v4_mul(e, g), orient);
+  v4m contributes = v4_and(v4_and(alive, v4_gt(orient, zero)), front);
+  v4f res = v4_sel(zero, v4_max(imp, v4_splat(LT_IMPORTANCE_FLOOR)), contributes);
+  if (fallback && !(v4_sum(res) > 0.0f) && emax > 0.0f)
+    res = v4_sel(zero, v4_max(v4_mul(e, g), v4_splat(LT_IMPORTANCE_FLOOR)), alive);
+  return res;
+}
+
+// Importance of four lanes for a query: a point (lt_importance_v; N as the caller passes it, which
+// the orientation ablation may have cleared) or a segment (lt_importance_seg_v).
+LT_HOT v4f lt_importance_q_v(const LtLanes* l, const LtQuery* q, float3 N, int fallback) {
+  if (LT_QUERY_IS_SEGMENT(q)) return lt_importance_seg_v(l, q, fallback);
+  return lt_importance_v(l, q->P, N, fallback);
+}
+
 LT_HOT float4 lt_importance4(float4 cx, float4 cy, float4 cz, float4 r, float4 ax, float4 ay,
                              float4 az, float4 cos_o, float4 cos_e, float4 energy, float3 P,
                              float3 N) {
@@ -239,29 +367,44 @@ LT_HOT LtLanes lt_code_lanes4(const LtTree* t, int code, float3* N) {
   return code >= 0 ? lt_node_lanes(t, code, N) : lt_leaf_lanes(t, code, N);
 }
 
-// Importance of the (up to four) emitters of a leaf (`fallback`: see lt_importance_v).
-LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N, int fallback) {
+// Importance of the (up to four) emitters of a leaf (`fallback`: see lt_importance_v) and of the
+// four children of a node, for a query. The lanes take a copy of q->N, which the orientation
+// ablation clears (a point's normal; a segment's direction is kept).
+LT_HOT float4 lt_leaf_importance_q(const LtTree* t, int code, const LtQuery* q, int fallback) {
+  float3 N = q->N;
   LtLanes l = lt_leaf_lanes(t, code, &N);
-  return v4_to_f4(lt_importance_v(&l, P, N, fallback));
+  return v4_to_f4(lt_importance_q_v(&l, q, N, fallback));
+}
+LT_HOT float4 lt_node_importance_q(const LtTree* t, int node, const LtQuery* q, int fallback) {
+  float3 N = q->N;
+  LtLanes l = lt_node_lanes(t, node, &N);
+  return v4_to_f4(lt_importance_q_v(&l, q, N, fallback));
+}
+// Importances of the four lanes below `code` (a node or a leaf) for the split decisions: without
+// the fallback, so a cluster splits into exactly the lanes that can contribute (none where P sees
+// no emitter of the cluster: a point behind a ceiling of one-sided lights gets an empty cut).
+INLINE float4 lt_code_importance_q(const LtTree* t, int code, const LtQuery* q) {
+  return code >= 0 ? lt_node_importance_q(t, code, q, 0) : lt_leaf_importance_q(t, code, q, 0);
+}
+
+// The point forms (shading point P, normal N).
+LT_HOT float4 lt_leaf_importance_f(const LtTree* t, int code, float3 P, float3 N, int fallback) {
+  LtQuery q = lt_query_point(P, N);
+  return lt_leaf_importance_q(t, code, &q, fallback);
 }
 LT_HOT float4 lt_leaf_importance(const LtTree* t, int code, float3 P, float3 N) {
   return lt_leaf_importance_f(t, code, P, N, 1);
 }
-
 LT_HOT float4 lt_node_importance_f(const LtTree* t, int node, float3 P, float3 N, int fallback) {
-  LtLanes l = lt_node_lanes(t, node, &N);
-  return v4_to_f4(lt_importance_v(&l, P, N, fallback));
+  LtQuery q = lt_query_point(P, N);
+  return lt_node_importance_q(t, node, &q, fallback);
 }
 LT_HOT float4 lt_node_importance(const LtTree* t, int node, float3 P, float3 N) {
   return lt_node_importance_f(t, node, P, N, 1);
 }
-
-// Importances of the four lanes below `code` (a node or a leaf) for the split decisions: without
-// the fallback, so a cluster splits into exactly the lanes that can contribute (none where P sees
-// no emitter of the cluster: a point behind a ceiling of one-sided lights gets an empty cut).
 INLINE float4 lt_code_importance(const LtTree* t, int code, float3 P, float3 N) {
-  return code >= 0 ? lt_node_importance_f(t, code, P, N, 0)
-                   : lt_leaf_importance_f(t, code, P, N, 0);
+  LtQuery q = lt_query_point(P, N);
+  return lt_code_importance_q(t, code, &q);
 }
 
 #endif // CANOPY_LIGHT_TREE_IMPORTANCE_H

@@ -6,6 +6,7 @@
 
 #include "../compat.h"
 #include "layout.h"
+#include "query.h"
 
 // A cut budget that never binds (the exhaustive sampler: threshold 1 splits down to every light).
 #define LT_BUDGET_UNLIMITED 0x7fffffffu
@@ -65,6 +66,15 @@ INLINE float lt_split_measure(float3 P, float4 sphere, float cv2_e) {
   float sigma = sqrt(cv2);
   return 1.0f / sqrt(sqrt(1.0f + sigma));
 }
+// The split measure for a query: a point's lt_split_measure, and for a segment in a medium the
+// same measure at the segment's point closest to the sphere's centre. The paper (§5.4, last
+// paragraph) found the quadratic-decay heuristic better for media too, although the importance
+// decays as 1/d there (Eq. 7): it prevents over-splitting.
+INLINE float lt_split_measure_q(const LtQuery* q, float4 sphere, float cv2_e) {
+  if (LT_QUERY_IS_SEGMENT(q))
+    return lt_split_measure(lt_query_closest(q, xyz_of(sphere)), sphere, cv2_e);
+  return lt_split_measure(q->P, sphere, cv2_e);
+}
 INLINE int lt_should_split(float measure, float threshold) {
   return threshold >= 1.0f || measure < threshold;
 }
@@ -83,11 +93,16 @@ INLINE int lt_code_lanes(const LtTree* t, int code) {
   int4 c = t->children[code];
   return (c.x != LT_EMPTY) + (c.y != LT_EMPTY) + (c.z != LT_EMPTY) + (c.w != LT_EMPTY);
 }
-INLINE int lt_item_splits(const LtTree* t, float4 sphere, float cv2, int code, uint budget,
-                          float3 P, float threshold) {
+INLINE int lt_item_splits_q(const LtTree* t, float4 sphere, float cv2, int code, uint budget,
+                            const LtQuery* q, float threshold) {
   int m = lt_code_lanes(t, code);
   if (m < 1 || (uint)m > budget) return 0;
-  return lt_should_split(lt_split_measure(P, sphere, cv2), threshold);
+  return lt_should_split(lt_split_measure_q(q, sphere, cv2), threshold);
+}
+INLINE int lt_item_splits(const LtTree* t, float4 sphere, float cv2, int code, uint budget,
+                          float3 P, float threshold) {
+  LtQuery q = lt_query_point(P, make_float3(0.0f, 0.0f, 0.0f));
+  return lt_item_splits_q(t, sphere, cv2, code, budget, &q, threshold);
 }
 // The child item of node `node` in lane `lane` (sphere and CV^2 from the node's lanes).
 INLINE float4 lt_lane_sphere(const LtTree* t, int node, int lane) {
@@ -110,8 +125,8 @@ INLINE float lt_lane_cv2(const LtTree* t, int node, int lane) {
 // of N / max_cut lights however near. The budgets sum to at most `budget` (lt_item_splits ensures
 // budget >= lanes) and depend on the node's lanes only, so lt_pmf_split recomputes them along one
 // trail.
-INLINE int4 lt_child_budgets(const LtTree* t, int node, float4 imp, uint budget, float3 P,
-                             float threshold) {
+INLINE int4 lt_child_budgets_q(const LtTree* t, int node, float4 imp, uint budget, const LtQuery* q,
+                               float threshold) {
   if (budget >= LT_BUDGET_UNLIMITED) { // the exhaustive sampler: every child keeps it
     int u = (int)LT_BUDGET_UNLIMITED;
     return make_int4(imp.x > 0.0f ? u : 0, imp.y > 0.0f ? u : 0, imp.z > 0.0f ? u : 0,
@@ -127,7 +142,7 @@ INLINE int4 lt_child_budgets(const LtTree* t, int node, float4 imp, uint budget,
     cap[j] = 1u;
     if (!(f4_get(imp, j) > 0.0f)) continue;
     k += 1u;
-    if (!lt_should_split(lt_split_measure(P, lt_lane_sphere(t, node, j), lt_lane_cv2(t, node, j)),
+    if (!lt_should_split(lt_split_measure_q(q, lt_lane_sphere(t, node, j), lt_lane_cv2(t, node, j)),
                          threshold))
       continue;
     int c = i4_get(ch, j);
@@ -153,6 +168,12 @@ INLINE int4 lt_child_budgets(const LtTree* t, int node, float4 imp, uint budget,
     b[j] = f4_get(imp, j) > 0.0f ? 1u + (extra < cap[j] - 1u ? extra : cap[j] - 1u) : 0u;
   }
   return make_int4((int)b[0], (int)b[1], (int)b[2], (int)b[3]);
+}
+
+INLINE int4 lt_child_budgets(const LtTree* t, int node, float4 imp, uint budget, float3 P,
+                             float threshold) {
+  LtQuery q = lt_query_point(P, make_float3(0.0f, 0.0f, 0.0f));
+  return lt_child_budgets_q(t, node, imp, budget, &q, threshold);
 }
 
 #endif // CANOPY_LIGHT_TREE_SPLIT_H

@@ -7,6 +7,7 @@
 #include "../compat.h"
 #include "importance.h"
 #include "layout.h"
+#include "query.h"
 #include "rng.h"
 
 // Prefetches the records of the children of a node that the next step may read: node records
@@ -28,16 +29,17 @@ LT_HOT void lt_prefetch_children(const LtTree* t, int4 ch) {
   }
 }
 
-// Stochastic descent (Alg. 2) from `code` (a node index or a leaf code) to one light, each
-// decision from fresh words of `rng` (lt_choose_lane). Returns the light index, or -1 if nothing
-// below `code` contributes; *prob = product of the lane probabilities taken below `code`.
-INLINE int lt_pick_below(const LtTree* t, int code, float3 P, float3 N, LtRng* rng, float* prob) {
+// Stochastic descent (Alg. 2) from `code` (a node index or a leaf code) to one light for query q
+// (a shading point, §5.1, or a ray segment in a medium, §5.2), each decision from fresh words of
+// `rng` (lt_choose_lane). Returns the light index, or -1 if nothing below `code` contributes;
+// *prob = product of the lane probabilities taken below `code`.
+INLINE int lt_pick_below_q(const LtTree* t, int code, const LtQuery* q, LtRng* rng, float* prob) {
   float p = 1.0f;
   *prob = 0.0f;
   while (code >= 0) {
     int4 ch = t->children[code];
     lt_prefetch_children(t, ch);
-    float4 imp = lt_node_importance(t, code, P, N);
+    float4 imp = lt_node_importance_q(t, code, q, 1);
     int lane = lt_choose_lane(imp, rng);
     if (lane < 0) return -1;
     p = p * lt_lane_prob(imp, lane);
@@ -52,12 +54,18 @@ INLINE int lt_pick_below(const LtTree* t, int code, float3 P, float3 N, LtRng* r
     LT_PREFETCH(L);
     LT_PREFETCH((GLOBAL const float4*)L + 5);
   }
-  float4 imp = lt_leaf_importance(t, code, P, N);
+  float4 imp = lt_leaf_importance_q(t, code, q, 1);
   int lane = lt_choose_lane(imp, rng);
   if (lane < 0) return -1;
   p = p * lt_lane_prob(imp, lane);
   *prob = p;
   return (int)float_as_uint_(rec[lane * LT_EMITTER_F4 + 1].w); // = leaf_lights[first + lane]
+}
+
+// The descent for a shading point P with unit normal N (0: none).
+INLINE int lt_pick_below(const LtTree* t, int code, float3 P, float3 N, LtRng* rng, float* prob) {
+  LtQuery q = lt_query_point(P, N);
+  return lt_pick_below_q(t, code, &q, rng, prob);
 }
 
 #endif // CANOPY_LIGHT_TREE_TRAVERSE_H

@@ -59,12 +59,16 @@ struct SamplerConfig {
   bool orientation = true;
   bool mis = true;
   BrdfSettings brdf;
+  // With a medium: "/midpoint" ranks light clusters for a ray segment by the surface importance
+  // at its midpoint (the ablation of Conty Estevez & Kulla's segment importance, Eq. 7).
+  bool volume_midpoint = false;
 };
 
 constexpr std::string_view kNoOrientSuffix = "-noorient";
-constexpr std::string_view kNoMisSuffix = "nomis"; // after a '/'
-constexpr std::string_view kEqualSuffix = "equal"; // after a '/'
-constexpr float kMaxBrdfDelta = 1000.0f;           // as `canopy render --brdf-delta`
+constexpr std::string_view kNoMisSuffix = "nomis";       // after a '/'
+constexpr std::string_view kEqualSuffix = "equal";       // after a '/'
+constexpr std::string_view kMidpointSuffix = "midpoint"; // after a '/'
+constexpr float kMaxBrdfDelta = 1000.0f;                 // as `canopy render --brdf-delta`
 
 bool is_brdf_sampler(const std::string& sampler) {
   return sampler == "brdf-mis" || sampler == "brdf-oriented";
@@ -121,11 +125,14 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
         c.mis = false;
       } else if (suffix == kEqualSuffix && !equal) {
         equal = true;
+      } else if (suffix == kMidpointSuffix && !c.volume_midpoint) {
+        c.volume_midpoint = true;
       } else {
         throw SceneError(fmt::format("{}: '{}': unknown or repeated suffix '/{}' (/{}: MIS off; "
-                                     "/{}: brdf-mis with equal allocation)",
+                                     "/{}: brdf-mis with equal allocation; /{}: medium segments "
+                                     "ranked at their midpoint)",
                                      option, printable(text, 256), printable(suffix, 256),
-                                     kNoMisSuffix, kEqualSuffix));
+                                     kNoMisSuffix, kEqualSuffix, kMidpointSuffix));
       }
     }
     if (!any)
@@ -301,6 +308,7 @@ std::ofstream open_out(const fs::path& file) {
 void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, Progress& progress) {
   SamplerConfig c = parse_config(a.reference_sampler, base.integrator, "--reference-sampler");
   Scene scene = base;
+  scene.integrator.volume_importance = c.volume_midpoint ? "midpoint" : "segment";
   Renderer r(rt, scene, renderer_options(c, base));
   const int half_spp = std::max(1, a.reference_spp / 2);
   auto t0 = Clock::now();
@@ -459,6 +467,8 @@ int run_converge(const ConvergeArgs& a) {
                               configs.size(), res.config.label),
                   false);
     scenes.push_back(std::make_unique<Scene>(base));
+    scenes.back()->integrator.volume_importance =
+        res.config.volume_midpoint ? "midpoint" : "segment";
     renderers.push_back(
         std::make_unique<Renderer>(rt, *scenes.back(), renderer_options(res.config, base)));
     Renderer& renderer = *renderers.back();

@@ -51,6 +51,7 @@ struct RenderArgs {
   std::optional<float> brdf_delta, brdf_lambda;
   std::optional<int> brdf_n_max;
   bool brdf_equal = false;
+  std::optional<std::string> volume_importance;
   std::string out, png, device, stats_json, heatmap;
   bool stats = false;
 };
@@ -220,6 +221,7 @@ int run_render(const RenderArgs& args) {
     scene.integrator.brdf_lambda = *args.brdf_lambda;
   }
   if (args.brdf_equal) scene.integrator.brdf_adaptive = false;
+  if (args.volume_importance) scene.integrator.volume_importance = *args.volume_importance;
 
   auto [exr, png] = output_paths(args);
   check_writable(exr, args.out.empty() ? "output" : "--out");
@@ -392,6 +394,11 @@ int main(int argc, char** argv) {
                      "brdf-mis: BRDF-aware samples per glossy point at most (default 50)");
   render->add_option("--brdf-lambda", rargs.brdf_lambda,
                      "brdf-mis: weight of BSDF hits in the adaptive allocation (default 10)");
+  render
+      ->add_option("--volume-importance", rargs.volume_importance,
+                   "With a medium: rank light clusters for a ray segment by the segment importance "
+                   "(segment, the default) or by the surface importance at its midpoint (midpoint)")
+      ->check(CLI::IsMember({"segment", "midpoint"}));
   render->add_flag("--brdf-equal", rargs.brdf_equal,
                    "brdf-mis: one sample of each technique instead of adaptive allocation");
   render->add_flag("--no-mis", rargs.no_mis,

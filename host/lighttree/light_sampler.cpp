@@ -177,14 +177,14 @@ private:
 
 } // namespace
 
-void sample_tree(const LtTree& t, float3 P, float3 N, Rng& rng, std::vector<LightPick>& out) {
+void sample_tree_q(const LtTree& t, const LtQuery& q, Rng& rng, std::vector<LightPick>& out) {
   float prob;
-  int l = lt_pick_below(&t, 0, P, N, &rng, &prob);
+  int l = lt_pick_below_q(&t, 0, &q, &rng, &prob);
   if (l >= 0) out.push_back({l, prob});
 }
 
-void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float threshold, int max_cut,
-                       std::vector<LightPick>& out) {
+void sample_tree_split_q(const LtTree& t, const LtQuery& q, Rng& rng, float threshold, int max_cut,
+                         std::vector<LightPick>& out) {
   struct Item {
     float4 sphere;
     float cv2;
@@ -198,15 +198,15 @@ void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float thre
   stack[top++] = {t.root_sphere, t.root_info.x, 0, uint(max_cut)};
   while (top > 0) {
     Item it = stack[--top];
-    if (lt_item_splits(&t, it.sphere, it.cv2, it.code, it.budget, P, threshold)) {
-      float4 imp = lt_code_importance(&t, it.code, P, N);
+    if (lt_item_splits_q(&t, it.sphere, it.cv2, it.code, it.budget, &q, threshold)) {
+      float4 imp = lt_code_importance_q(&t, it.code, &q);
       if (it.code < 0) {
         int first = lt_leaf_first(it.code);
         for (int j = 0; j < lt_leaf_count(it.code); ++j)
           if (f4_get(imp, j) > 0.0f) out.push_back({t.leaf_lights[first + j], 1.0f});
       } else {
         int4 ch = t.children[it.code];
-        int4 budgets = lt_child_budgets(&t, it.code, imp, it.budget, P, threshold);
+        int4 budgets = lt_child_budgets_q(&t, it.code, imp, it.budget, &q, threshold);
         for (int lane = 3; lane >= 0; --lane) {
           int c = i4_get(ch, lane);
           if (c == LT_EMPTY || !(f4_get(imp, lane) > 0.0f)) continue;
@@ -216,10 +216,19 @@ void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float thre
       }
     } else {
       float prob;
-      int l = lt_pick_below(&t, it.code, P, N, &rng, &prob);
+      int l = lt_pick_below_q(&t, it.code, &q, &rng, &prob);
       if (l >= 0) out.push_back({l, prob});
     }
   }
+}
+
+void sample_tree(const LtTree& t, float3 P, float3 N, Rng& rng, std::vector<LightPick>& out) {
+  sample_tree_q(t, lt_query_point(P, N), rng, out);
+}
+
+void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float threshold, int max_cut,
+                       std::vector<LightPick>& out) {
+  sample_tree_split_q(t, lt_query_point(P, N), rng, threshold, max_cut, out);
 }
 
 const std::vector<std::string>& light_sampler_names() {

@@ -12,6 +12,7 @@
 #pragma once
 
 #include "light_tree/pmf.h"      // cl/
+#include "light_tree/query.h"    // cl/
 #include "light_tree/split.h"    // cl/
 #include "light_tree/traverse.h" // cl/
 #include "lighttree/light_sampler_names.h"
@@ -94,6 +95,12 @@ private:
 // of the device's light_pick. sample_tree: Alg. 2 from the root. sample_tree_split: Alg. 3 as a
 // depth-first walk over split items (lt_item_splits, budget max_cut), one lt_pick_below per item
 // that does not split; every pick's prob equals lt_pmf_split() for its light.
+// The _q forms take a query (cl/light_tree/query.h): a shading point (lt_query_point) or a ray
+// segment in a medium (lt_query_segment, Conty Estevez & Kulla 2018 §5.2); the (P, N) forms are
+// point queries. Every pick's prob equals lt_pmf_below_q / lt_pmf_split_q for the same query.
+void sample_tree_q(const LtTree& t, const LtQuery& q, Rng& rng, std::vector<LightPick>& out);
+void sample_tree_split_q(const LtTree& t, const LtQuery& q, Rng& rng, float threshold, int max_cut,
+                         std::vector<LightPick>& out);
 void sample_tree(const LtTree& t, float3 P, float3 N, Rng& rng, std::vector<LightPick>& out);
 void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float threshold, int max_cut,
                        std::vector<LightPick>& out);

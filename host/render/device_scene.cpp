@@ -33,13 +33,14 @@ cl::Buffer upload_scaled_lights(const cl::Context& ctx, const std::vector<Light>
 DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geometry,
                                 const std::vector<Material>& materials,
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
-                                int emission_exponent) {
+                                int emission_exponent, const Medium& medium) {
   DeviceScene d;
   d.nodes = upload_buffer(ctx, geometry.bvh.nodes);
   d.prim_index = upload_buffer(ctx, geometry.bvh.prim_index);
   d.prims = upload_buffer(ctx, geometry.prims);
   d.materials = upload_buffer(ctx, materials);
   d.shading_normals = upload_buffer(ctx, geometry.shading_normals); // one element when empty
+  d.medium = upload_buffer(ctx, std::vector<Medium>{medium});
   upload_light_sampler(ctx, lights, sampler, emission_exponent, d);
   return d;
 }

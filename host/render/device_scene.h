@@ -26,7 +26,7 @@ cl::Buffer upload_buffer(const cl::Context& ctx, const std::vector<T>& v,
 
 struct DeviceScene {
 #define CANOPY_DEVICE_SCENE_BUFFER(T, name) cl::Buffer name;
-  SCENE_BUFFERS(CANOPY_DEVICE_SCENE_BUFFER) // nodes, prim_index, prims, materials, normals
+  SCENE_BUFFERS(CANOPY_DEVICE_SCENE_BUFFER) // nodes, prim_index, prims, materials, normals, medium
 #undef CANOPY_DEVICE_SCENE_BUFFER
   cl::Buffer lights;
   cl::Buffer power_pmf, alias_prob, alias_index, lt_nodes, lt_children, lt_leaf_lights, lt_trails;
@@ -49,7 +49,7 @@ struct DeviceScene {
 DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geometry,
                                 const std::vector<Material>& materials,
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
-                                int emission_exponent = 0);
+                                int emission_exponent = 0, const Medium& medium = {});
 
 // Uploads only the lights and the light sampler's buffers into `d` (the part of
 // upload_device_scene that the pick tests and benchmarks need without any geometry).

@@ -37,10 +37,11 @@ std::string KernelFeatures::build_options() const {
                      "-DHAS_LIGHT_SPHERE={} -DHAS_LIGHT_QUAD={} -DHAS_LIGHT_TRIANGLE={} "
                      "-DHAS_LIGHT_DISK={} -DHAS_PRIM_SPHERE={} -DHAS_PRIM_DISK={} "
                      "-DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} -DHAS_MEDIUM={} "
-                     "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={}",
+                     "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={} -DCANOPY_VOLUME_MIDPOINT={}",
                      int(light_point), int(light_spot), int(light_sphere), int(light_quad),
                      int(light_triangle), int(light_disk), int(prim_sphere), int(prim_disk),
-                     int(material_conductor), int(material_plastic), int(medium), light_sampler, int(mis));
+                     int(material_conductor), int(material_plastic), int(medium), light_sampler,
+                     int(mis), int(volume_midpoint));
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {
@@ -70,6 +71,8 @@ KernelFeatures scene_features(const Scene& scene, int light_sampler) {
       break;
     }
   }
+  f.medium = scene.has_medium;
+  f.volume_midpoint = scene.has_medium && scene.integrator.volume_importance == "midpoint";
   for (const MaterialDesc& m : scene.materials) {
     f.material_conductor |= m.gpu.type == MATERIAL_CONDUCTOR;
     f.material_plastic |= m.gpu.type == MATERIAL_PLASTIC;

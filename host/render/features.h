@@ -13,9 +13,10 @@ struct KernelFeatures {
        light_triangle = false, light_disk = false;
   bool prim_sphere = false, prim_disk = false;
   bool material_conductor = false, material_plastic = false;
-  bool medium = false; // a participating medium (cl/volume/, shade_volume)
-  int light_sampler = 0; // SAMPLER_* (cl/types.h)
-  bool mis = true;       // RendererOptions::mis
+  bool medium = false;          // a participating medium (cl/volume/, shade_volume)
+  bool volume_midpoint = false; // medium segments ranked at their midpoint (ablation)
+  int light_sampler = 0;        // SAMPLER_* (cl/types.h)
+  bool mis = true;              // RendererOptions::mis
 
   // Everything on (for the test that checks specialisation changes nothing).
   static KernelFeatures all(int light_sampler);

@@ -27,9 +27,9 @@ cl::Buffer device_buffer(const cl::Context& ctx, size_t bytes) {
 }
 
 const std::vector<std::string> kKernelFiles = {
-    "kernels/compact.cl",       "kernels/generate.cl",   "kernels/intersect_closest.cl",
-    "kernels/shade_surface.cl", "kernels/light_pick.cl", "kernels/intersect_shadow.cl",
-    "kernels/brdf_mis.cl",      "kernels/accumulate.cl"};
+    "kernels/compact.cl",          "kernels/generate.cl",      "kernels/intersect_closest.cl",
+    "kernels/shade_volume.cl",     "kernels/shade_surface.cl", "kernels/light_pick.cl",
+    "kernels/intersect_shadow.cl", "kernels/brdf_mis.cl",      "kernels/accumulate.cl"};
 
 constexpr int kScanBlock = 256;
 constexpr int kCutBins = 65;
@@ -136,7 +136,7 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   const cl::Context& ctx = rt.context();
   stats_.emission_exponent = emission_scale_exponent(scene.lights);
   device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
-                                stats_.emission_exponent);
+                                stats_.emission_exponent, scene.medium);
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
   camera_ = upload_buffer(ctx, cam);
@@ -145,9 +145,13 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   t0 = Clock::now();
   KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_.kind)
                                                  : scene_features(scene, sampler_.kind);
+  features.volume_midpoint = scene.has_medium && scene.integrator.volume_importance == "midpoint";
   features.mis = options.mis;
   brdf_stages_ =
       sampler_.brdf_oriented() && (features.material_conductor || features.material_plastic);
+  // Kernels with the medium feature run shade_volume (on a scene without a medium, its record is
+  // vacuum: every path passes unchanged, so forcing the feature on changes no image).
+  volume_stages_ = features.medium;
   stats_.kernel_options = features.build_options();
   program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
@@ -162,18 +166,21 @@ Film Renderer::render(const RenderSettings& settings) {
   const int npix = width * height;
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
   // Every path's cut has at most max_cut items in any pass, so waves of
-  // split_queue_items / max_cut paths bound the split queue.
+  // split_queue_items / max_cut paths bound the split queue. With a medium a path has two cuts (its
+  // segment's and its surface point's), and a split item stages up to 8 shadow items, not 4.
+  const bool medium = volume_stages_;
+  const size_t roots = medium ? 2 : 1, shadow_slots = medium ? 8 : 4;
   size_t wave = std::max<size_t>(
-      1, std::min(settings.wave_size, options_.split_queue_items / sampler_.max_cut));
+      1, std::min(settings.wave_size, options_.split_queue_items / (roots * sampler_.max_cut)));
   const size_t W = size_t(std::min<uint64_t>(total, wave));
-  const size_t split_cap = W * sampler_.max_cut;
+  const size_t split_cap = W * roots * sampler_.max_cut;
   const int max_depth = scene_.integrator.max_depth;
   // Fail before any work if the film or the wave does not fit (docs/limits.md).
   check_memory(rt_.device(),
                {{"film_sum", uint64_t(npix) * sizeof(double4)},
                 {"film_sumsq", uint64_t(npix) * sizeof(double4)},
                 {"film_counts", uint64_t(npix) * sizeof(double2)},
-                {"shadow_stage", 4 * uint64_t(split_cap) * sizeof(ShadowItem)},
+                {"shadow_stage", shadow_slots * uint64_t(split_cap) * sizeof(ShadowItem)},
                 {"child_stage", 4 * uint64_t(split_cap) * sizeof(SplitItem)},
                 {"brdf_stage", uint64_t(brdf_stages_ ? W : 1) * BRDF_MAX_BATCH * sizeof(BrdfItem)}},
                {{"film (host copy)", uint64_t(npix) * (2 * sizeof(double4) + sizeof(double2))},
@@ -207,7 +214,7 @@ Film Renderer::render(const RenderSettings& settings) {
   cl::Buffer split_a = device_buffer(ctx, split_cap * sizeof(SplitItem));
   cl::Buffer split_b = device_buffer(ctx, split_cap * sizeof(SplitItem));
   buffer("child_stage", 4 * split_cap * sizeof(SplitItem));
-  buffer("shadow_stage", 4 * split_cap * sizeof(ShadowItem));
+  buffer("shadow_stage", shadow_slots * split_cap * sizeof(ShadowItem));
   buffer("shadow_items", split_cap * sizeof(ShadowItem));
   cl::Buffer counts_pick = buffer("counts_pick", split_cap * sizeof(cl_int2));
   // BRDF-oriented sampling (brdf_mis.cl): each path's cut, one round's staged and compacted items.
@@ -217,6 +224,8 @@ Film Renderer::render(const RenderSettings& settings) {
   buffer("brdf_items", brdf_paths * BRDF_MAX_BATCH * sizeof(BrdfItem));
   cl::Buffer counts_brdf = buffer("counts_brdf", brdf_paths * sizeof(cl_int2));
   cl::Buffer brdf_counters = buffer("brdf_counters", 4 * sizeof(cl_int));
+  // shade_volume / light_pick: segments with light samples and their shadow rays (per wave)
+  cl::Buffer volume_counters = buffer("volume_counters", 2 * sizeof(cl_int));
   buffer("offsets", split_cap * sizeof(cl_int2));
   buffer("block_sums", (split_cap / kScanBlock + 2) * sizeof(cl_int2));
   cl::Buffer totals = buffer("totals", 2 * sizeof(cl_int));
@@ -234,6 +243,7 @@ Film Renderer::render(const RenderSettings& settings) {
   // render at 2^24 spp has more than 2^31 samples.
   auto reset_counters = [&] {
     q.enqueueFillBuffer(brdf_counters, cl_int(0), 0, 4 * sizeof(cl_int));
+    q.enqueueFillBuffer(volume_counters, cl_int(0), 0, 2 * sizeof(cl_int));
     q.enqueueFillBuffer(nonfinite, cl_int(0), 0, sizeof(cl_int));
     q.enqueueFillBuffer(histogram, cl_int(0), 0, kCutBins * sizeof(cl_int));
   };
@@ -252,6 +262,8 @@ Film Renderer::render(const RenderSettings& settings) {
   BoundKernel k_accumulate(program_, "accumulate", args);
   BoundKernel k_scan_blocks(program_, "scan_blocks", args);
   BoundKernel k_scan_sums(program_, "scan_block_sums", args);
+  std::optional<BoundKernel> k_volume;
+  if (medium) k_volume.emplace(program_, "shade_volume", args);
   std::optional<BoundKernel> k_brdf_cut, k_brdf_sample, k_brdf_scatter, k_brdf_trace, k_brdf_sum;
   if (brdf_stages_) {
     k_brdf_cut.emplace(program_, "brdf_cut", args);
@@ -290,6 +302,9 @@ Film Renderer::render(const RenderSettings& settings) {
     int count = count0;
     for (int depth = 0; depth < max_depth && count > 0; ++depth) {
       run("intersect_closest", k_closest.bind({{"queue", *q_in}, {"count", count}}), size_t(count));
+      if (medium)
+        run("shade_volume", k_volume->bind({{"depth", depth}, {"queue", *q_in}, {"count", count}}),
+            size_t(count));
       run("shade_surface", k_shade.bind({{"depth", depth}, {"queue", *q_in}, {"count", count}}),
           size_t(count));
 
@@ -301,7 +316,7 @@ Film Renderer::render(const RenderSettings& settings) {
                                 {"queue_out", *q_out},
                                 {"split_out", split_a}}),
           size_t(count));
-      stats_.shading_points += uint64_t(shade_count);
+      stats_.shading_points += uint64_t(shade_count); // segments subtracted after the wave
       q.enqueueFillBuffer(cut_size, cl_int(0), 0, W * sizeof(cl_int));
       // The BRDF-oriented cuts first: tree light samples at glossy points are weighted with them.
       int brdf_rounds = 0; // enough for the bounce's largest N (brdf_mis.h)
@@ -359,6 +374,13 @@ Film Renderer::render(const RenderSettings& settings) {
     q.enqueueReadBuffer(nonfinite, CL_FALSE, 0, sizeof(nf), &nf);
     q.enqueueReadBuffer(histogram, CL_TRUE, 0, kCutBins * sizeof(cl_int), hist.data());
     stats_.nonfinite_samples += uint64_t(uint32_t(nf));
+    if (medium) {
+      cl_int vc[2];
+      q.enqueueReadBuffer(volume_counters, CL_TRUE, 0, sizeof(vc), vc);
+      stats_.medium_segments += uint64_t(uint32_t(vc[0]));
+      stats_.medium_shadow_rays += uint64_t(uint32_t(vc[1]));
+      stats_.shading_points -= uint64_t(uint32_t(vc[0]));
+    }
     if (brdf_stages_) {
       cl_int bc[3]; // the wave's totals (brdf_counters[3] is per bounce)
       q.enqueueReadBuffer(brdf_counters, CL_TRUE, 0, sizeof(bc), bc);

@@ -40,6 +40,9 @@ struct RenderStats {
   uint64_t glossy_points = 0, brdf_cut_sum = 0, brdf_samples_sum = 0;
   uint64_t brdf_rays = 0; // rays of the BRDF-aware samples (shadow rays and BSDF probes)
   uint64_t shadow_rays = 0;
+  // With a medium: ray segments that got light samples, and their shadow rays (also counted in
+  // shadow_rays; the rest are those of surface points)
+  uint64_t medium_segments = 0, medium_shadow_rays = 0;
   std::vector<uint64_t> cut_size_histogram; // shading points by number of cut members
   std::string kernel_options;               // the -D options the kernels were compiled with
   uint64_t nonfinite_samples = 0; // samples that were not finite and were recorded as zero
@@ -124,7 +127,8 @@ private:
   LightSamplerData sampler_;
   RenderStats stats_;
   cl::Program program_;
-  bool brdf_stages_ = false; // brdf-mis / brdf-oriented on a scene with a glossy material
+  bool brdf_stages_ = false;   // brdf-mis / brdf-oriented on a scene with a glossy material
+  bool volume_stages_ = false; // kernels with a medium: shade_volume and segment light picks
   DeviceScene device_;
   cl::Buffer camera_;
 };

@@ -41,6 +41,9 @@ inline constexpr float kMinConductorEta = 0.01f;
 inline constexpr float kMaxConductorIndex = 1000.0f; // eta and k
 inline constexpr float kMaxPlasticIor = 10.0f;
 inline constexpr float kDefaultPlasticIor = 1.5f;
+// Largest medium coefficient (per scene unit): sigma * distance stays finite in float over any
+// two points of the scene (2e18 * 1e20 < FLT_MAX), so transmittance underflows to 0, never NaN.
+inline constexpr float kMaxMediumCoefficient = 1e20f;
 
 // `s` made safe to echo inside a one-line message: control characters (including NUL and C1
 // controls), invalid UTF-8 and the Unicode line/paragraph separators become \n, \t, \xHH or
@@ -87,6 +90,9 @@ struct IntegratorSettings {
   int brdf_n_max = 50;
   float brdf_lambda = 10.0f;
   bool brdf_adaptive = true;
+  // With a medium: "segment" (Conty Estevez & Kulla Eq. 7) or "midpoint" (the surface importance
+  // at the segment's midpoint, an ablation) ranks light clusters for a ray segment.
+  std::string volume_importance = "segment";
 };
 // Largest brdf_n_max: it bounds the BRDF-aware samples of one shading point (and the rounds of
 // kernels per bounce, log2 of it).
@@ -155,6 +161,9 @@ struct Scene {
   std::vector<float3> shading_normals;
   std::vector<int32_t> triangle_normals;
   std::vector<Light> lights; // only lights that emit (zero-emission lights are skipped)
+  // A homogeneous participating medium (the scene's "medium"; cl/types.h Medium), if any.
+  bool has_medium = false;
+  Medium medium{};
   size_t skipped_lights = 0; // lights given with zero emission, not in `lights`
 
   size_t triangle_count() const { return indices.size() / 3; }

@@ -235,7 +235,7 @@ void parse_film(const JsonValue& v, FilmSettings& film) {
 void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
   auto o = v.as_object();
   o.allow({"spp", "max_depth", "light_sampler", "split_threshold", "max_cut", "seed", "mis",
-           "brdf_delta", "brdf_n_max", "brdf_lambda", "brdf_adaptive"});
+           "brdf_delta", "brdf_n_max", "brdf_lambda", "brdf_adaptive", "volume_importance"});
   if (auto x = o.get("spp")) in.spp = int(x->as_int(1, kMaxSpp));
   if (auto x = o.get("max_depth")) in.max_depth = int(x->as_int(1, kMaxDepth));
   if (auto x = o.get("light_sampler")) in.light_sampler = x->as_enum(kLightSamplerNames);
@@ -247,6 +247,37 @@ void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
   if (auto x = o.get("brdf_n_max")) in.brdf_n_max = int(x->as_int(1, kMaxBrdfSamples));
   if (auto x = o.get("brdf_lambda")) in.brdf_lambda = x->as_float_in(1e-3f, 1e6f);
   if (auto x = o.get("brdf_adaptive")) in.brdf_adaptive = x->as_bool();
+  if (auto x = o.get("volume_importance"))
+    in.volume_importance = x->as_enum({"segment", "midpoint"});
+}
+
+// The top-level "medium" (docs/scene-format.md, Participating media): homogeneous, everywhere or
+// inside a box.
+Medium parse_medium(const JsonValue& v) {
+  auto o = v.as_object();
+  o.allow({"sigma_a", "sigma_s", "g", "bounds"});
+  float3 sa = o.req("sigma_a").as_color_in(0.0f, kMaxMediumCoefficient);
+  float3 ss = o.req("sigma_s").as_color_in(0.0f, kMaxMediumCoefficient);
+  float g = 0.0f;
+  if (auto x = o.get("g")) g = x->as_float_open(-1.0f, 1.0f);
+  Medium m{};
+  m.sigma_t = make_float4(sa.x + ss.x, sa.y + ss.y, sa.z + ss.z, g);
+  m.sigma_s = make_float4(ss.x, ss.y, ss.z, 0.0f);
+  if (auto b = o.get("bounds")) {
+    auto bo = b->as_object();
+    bo.allow({"min", "max"});
+    auto lo = bo.req("min");
+    auto hi = bo.req("max");
+    float3 mn = lo.as_vec3(), mx = hi.as_vec3();
+    if (auto e = check_coordinate(mn); !e.empty()) lo.fail(e);
+    if (auto e = check_coordinate(mx); !e.empty()) hi.fail(e);
+    if (!(mn.x < mx.x && mn.y < mx.y && mn.z < mx.z))
+      hi.fail("must exceed bounds.min in every coordinate");
+    m.sigma_s.w = 1.0f;
+    m.bmin = make_float4(mn.x, mn.y, mn.z, 0.0f);
+    m.bmax = make_float4(mx.x, mx.y, mx.z, 0.0f);
+  }
+  return m;
 }
 
 // One entry of "materials" (docs/scene-format.md, Materials). Roughness r becomes GGX alpha = r^2.
@@ -344,10 +375,16 @@ Scene load_from_string(const std::string& json_text, const std::string& name,
 
   JsonValue root(doc, doc.root, name);
   auto o = root.as_object();
-  o.allow({"camera", "film", "integrator", "materials", "shapes", "lights", "light_sets"});
+  o.allow(
+      {"camera", "film", "integrator", "materials", "shapes", "lights", "light_sets", "medium"});
   parse_camera(o.req("camera"), scene.camera);
   if (auto x = o.get("film")) parse_film(*x, scene.film);
   if (auto x = o.get("integrator")) parse_integrator(*x, scene.integrator);
+  if (auto x = o.get("medium")) {
+    scene.medium = parse_medium(*x);
+    // A medium with sigma_t = 0 is vacuum: no medium code at all.
+    scene.has_medium = max3(xyz_of(scene.medium.sigma_t)) > 0.0f;
+  }
   if (auto x = o.get("materials")) parse_materials(*x, b);
   if (auto x = o.get("shapes")) parse_shapes(*x, b);
   if (auto x = o.get("lights")) {

@@ -1,0 +1,123 @@
+// Direct light in a homogeneous medium along a ray segment, one picked light at a time (Conty
+// Estevez & Kulla 2018, §5.2; equiangular sampling, Kulla & Fajardo 2012). The path's segment is
+// the part of this bounce's ray inside the medium (shade_volume.h writes it); light_pick ranks
+// light clusters for it with the segment importance (Eq. 7) and splits its cut with the surface
+// measure (§5.4), and for every light it picks stages up to two shadow items: the point of the
+// segment chosen by equiangular sampling towards the light, and the free-flight point of the
+// segment (the distance sample shade_volume drew), each MIS-weighted against the other technique
+// (power heuristic over their densities in t; both then sample the light from their point).
+//
+// Emission that a phase-function ray finds is not counted (shade_surface.h): this estimate covers
+// the direct light of every medium vertex. Canopy samples area lights by solid angle, so the
+// phase-function technique would add little but a third pdf to every weight.
+//
+// Compiles as OpenCL C and as C++.
+#ifndef CANOPY_INTEGRATOR_VOLUME_LIGHT_H
+#define CANOPY_INTEGRATOR_VOLUME_LIGHT_H
+
+#include "../light_sample.h"
+#include "../shading.h"
+#include "../volume/equiangular.h"
+#include "../volume/medium.h"
+#include "../volume/phase.h"
+#include "light_sampler.h"
+#include "path_state.h"
+
+// SplitItem.path flag: the item picks lights for the path's medium segment, not its surface point.
+#define SPLIT_SEGMENT 0x40000000
+// shade_f.w of a path whose last vertex is a scattering event in the medium.
+#define VOLUME_POINT_FLAG 4.0f
+// Hit.prim of a path that scattered in the medium before reaching its closest hit.
+#define HIT_SCATTERED (-2)
+
+#ifndef CANOPY_VOLUME_MIDPOINT
+#define CANOPY_VOLUME_MIDPOINT 0 // 1: rank clusters by the surface importance at the midpoint
+#endif
+
+// The light-pick query of the path's segment: the segment itself (Eq. 7), or under the ablation
+// its midpoint as a point without a normal (the surface importance, Eq. 3, without cos theta_i).
+INLINE LtQuery volume_query(const PathBuffers* pb, int path) {
+  float4 o = pb->seg_o[path];
+  float4 d = pb->seg_d[path];
+  if (CANOPY_VOLUME_MIDPOINT)
+    return lt_query_point(xyz_of(o) + xyz_of(d) * (0.5f * o.w), make_float3(0.0f, 0.0f, 0.0f));
+  return lt_query_segment(xyz_of(o), xyz_of(d), o.w);
+}
+
+// Where equiangular sampling aims for a light: its position (point, spot; exact) or the centre of
+// its shape (area lights, whose point is sampled afterwards from the chosen medium point).
+INLINE float3 light_center(GLOBAL const Light* l) {
+  if (IS_LIGHT(l, LIGHT_QUAD)) return xyz_of(l->p) + (xyz_of(l->e1) + xyz_of(l->e2)) * 0.5f;
+  if (IS_LIGHT(l, LIGHT_TRIANGLE))
+    return xyz_of(l->p) + (xyz_of(l->e1) + xyz_of(l->e2)) * (1.0f / 3.0f);
+  return xyz_of(l->p);
+}
+
+// Transmittance of the scene's medium along [0, tmax] of a ray (1 without a medium).
+INLINE float3 volume_transmittance(const SceneBuffers* sc, float3 o, float3 d, float tmax) {
+  if (!HAS_MEDIUM) return make_float3(1.0f, 1.0f, 1.0f);
+  Medium m = sc->medium[0];
+  return medium_transmittance(&m, o, d, tmax);
+}
+
+// The shadow item of a light sampled from the segment's point at distance t: beta Tr(t) sigma_s
+// p(theta) Li Tr(leg) times `weight` (the MIS weight over the density of t) / (pmf pdf(wi)).
+// Returns 1 if an item was written.
+INLINE int volume_light_item(const Medium* m, const LightSamplerCtx* ls, int path, float3 a,
+                             float3 d, float t, float weight, float3 beta, int light, float pmf,
+                             float u1, float u2, GLOBAL ShadowItem* out) {
+  float3 x = a + d * t;
+  LightSample s = sample_light(&ls->lights[light], x, u1, u2);
+  if (!(s.pdf > 0.0f) || !(max3(s.Li) > 0.0f)) return 0;
+  float3 to = s.x - x;
+  float dist = length(to);
+  if (!(dist > 0.0f)) return 0;
+  float3 dir = to / dist;
+  float tmax = fmax(dist - fp_gamma(6) * (max_abs3(s.x) + dist), 0.0f);
+  float3 tr = medium_tr(m, t) * medium_transmittance(m, x, dir, tmax);
+  float phase = phase_hg(m->sigma_t.w, dot(s.wi, d));
+  float3 c = beta * tr * xyz_of(m->sigma_s) * s.Li * (phase * weight / (pmf * s.pdf));
+  // Non-finite contributions are kept (accumulate counts them), zero ones dropped.
+  if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) return 0;
+  ShadowItem item;
+  item.origin = f4_from3(x, tmax);
+  item.dir = f4_from3(dir, uint_as_float_((uint)path));
+  item.contribution = f4_from3(c, 0.0f);
+  *out = item;
+  return 1;
+}
+
+// The (up to two) shadow items of `light`, picked with probability pmf for the segment of `path`.
+INLINE int volume_shadow_items(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                               const PathBuffers* pb, int path, int light, float pmf, LtRng* rng,
+                               GLOBAL ShadowItem* out) {
+  float u0 = lt_rng_next(rng), u1 = lt_rng_next(rng), u2 = lt_rng_next(rng);
+  float u3 = lt_rng_next(rng), u4 = lt_rng_next(rng);
+  if (!(pmf > 0.0f)) return 0;
+  Medium m = sc->medium[0];
+  float4 so = pb->seg_o[path];
+  float4 sd = pb->seg_d[path];
+  float3 beta = xyz_of(pb->seg_beta[path]);
+  float3 a = xyz_of(so), d = xyz_of(sd);
+  float len = so.w, t_free = sd.w;
+  float3 c = light_center(&ls->lights[light]);
+  int n = 0;
+  // Equiangular sampling towards the light (exact for point lights: pdf ~ 1 / |x(t) - c|^2).
+  float p_eq = 0.0f;
+  float t_eq = equiangular_sample(a, d, len, c, u0, &p_eq);
+  if (p_eq > 0.0f) {
+    float w = power_heuristic(p_eq, medium_distance_pdf(&m, t_eq)) / p_eq;
+    n += volume_light_item(&m, ls, path, a, d, t_eq, w, beta, light, pmf, u1, u2, out + n);
+  }
+  // The free-flight point, if it falls on the segment.
+  if (t_free < len) {
+    float p_ff = medium_distance_pdf(&m, t_free);
+    if (p_ff > 0.0f) {
+      float w = power_heuristic(p_ff, equiangular_pdf(a, d, len, c, t_free)) / p_ff;
+      n += volume_light_item(&m, ls, path, a, d, t_free, w, beta, light, pmf, u3, u4, out + n);
+    }
+  }
+  return n;
+}
+
+#endif // CANOPY_INTEGRATOR_VOLUME_LIGHT_H
