@@ -238,6 +238,37 @@ TEST(LightTreeSegment, ImportancePositiveForLightsThatLightTheSegment) {
   EXPECT_GT(nculled, 5000);
 }
 
+// The midpoint ablation (lt_query_midpoint: the surface importance at the segment's midpoint with
+// bounds grown by half the segment) is conservative too: every light that lights some point of the
+// segment keeps pmf > 0. Without the growth it is not (some such light would be culled).
+TEST(LightTreeSegment, MidpointQueryKeepsEveryLightThatLightsTheSegment) {
+  std::vector<Light> lights = segment_lights(1500, 500, 41);
+  LightTree tree = build_light_tree(lights);
+  LtTree t = tree.view(lights.data());
+  std::vector<LtQuery> segs = random_segments(lights, 60, 45);
+  std::vector<int> checked(segs.size(), 0), lost_plain(segs.size(), 0);
+  tbb::parallel_for(0, int(segs.size()), [&](int i) {
+    const LtQuery& s = segs[size_t(i)];
+    LtQuery q = lt_query_midpoint(s.P, s.N, s.len);
+    LtQuery plain = lt_query_point(q.P, make_float3(0, 0, 0));
+    for (int l = 0; l < int(lights.size()); ++l) {
+      if (!lights_segment(lights[size_t(l)], s)) continue;
+      ++checked[size_t(i)];
+      EXPECT_GT(lt_pmf_below_q(&t, 0, &q, tree.trails[size_t(l)]), 0.0f)
+          << "segment " << i << " light " << l;
+      EXPECT_GT(lt_pmf_split_q(&t, &q, l, 0.9f, 64u), 0.0f) << "segment " << i << " light " << l;
+      lost_plain[size_t(i)] += lt_pmf_below_q(&t, 0, &plain, tree.trails[size_t(l)]) == 0.0f;
+    }
+  });
+  int nchecked = 0, nlost = 0;
+  for (size_t i = 0; i < segs.size(); ++i) {
+    nchecked += checked[i];
+    nlost += lost_plain[i];
+  }
+  EXPECT_GT(nchecked, 50000);
+  EXPECT_GT(nlost, 0); // the growth is needed
+}
+
 // Tree: the pmfs sum to 1. Splitting: they sum to the cut's size (each item not split yields one
 // pick, each light of a split leaf is taken with probability 1), every pick's prob equals the
 // evaluated pmf bit for bit, under both samplers.

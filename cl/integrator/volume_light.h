@@ -35,12 +35,12 @@
 #endif
 
 // The light-pick query of the path's segment: the segment itself (Eq. 7), or under the ablation
-// its midpoint as a point without a normal (the surface importance, Eq. 3, without cos theta_i).
+// its midpoint as a point without a normal (the surface importance, Eq. 3, without cos theta_i,
+// with bounds grown by half the segment so that it stays conservative: query.h).
 INLINE LtQuery volume_query(const PathBuffers* pb, int path) {
   float4 o = pb->seg_o[path];
   float4 d = pb->seg_d[path];
-  if (CANOPY_VOLUME_MIDPOINT)
-    return lt_query_point(xyz_of(o) + xyz_of(d) * (0.5f * o.w), make_float3(0.0f, 0.0f, 0.0f));
+  if (CANOPY_VOLUME_MIDPOINT) return lt_query_midpoint(xyz_of(o), xyz_of(d), o.w);
   return lt_query_segment(xyz_of(o), xyz_of(d), o.w);
 }
 

@@ -259,6 +259,13 @@ LT_HOT v4f lt_importance_seg_v(const LtLanes* l, const LtQuery* q, int fallback)
 // the orientation ablation may have cleared) or a segment (lt_importance_seg_v).
 LT_HOT v4f lt_importance_q_v(const LtLanes* l, const LtQuery* q, float3 N, int fallback) {
   if (LT_QUERY_IS_SEGMENT(q)) return lt_importance_seg_v(l, q, fallback);
+  float slack = LT_QUERY_SLACK(q);
+  if (slack > 0.0f) { // the midpoint ablation (query.h): spheres and half-spaces grown by slack
+    LtLanes w = *l;
+    w.r = v4_add(l->r, v4_splat(slack));
+    w.plane_h = v4_add(l->plane_h, v4_splat(slack));
+    return lt_importance_v(&w, q->P, N, fallback);
+  }
   return lt_importance_v(l, q->P, N, fallback);
 }
 

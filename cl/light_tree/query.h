@@ -30,6 +30,19 @@ INLINE LtQuery lt_query_segment(float3 a, float3 d, float len) {
   return q;
 }
 
+// The midpoint ablation (the surface importance, Eq. 3, at the segment's midpoint without a
+// normal): a point query that carries the segment's half-length s as len = -1 - s, so the
+// importance can grow every bounding sphere by s. Then the cone seen from the midpoint around a
+// grown sphere holds every direction from the cluster to any point of the segment, and no lane
+// that can light the segment gets importance 0 (the pick stays unbiased).
+INLINE LtQuery lt_query_midpoint(float3 a, float3 d, float len) {
+  LtQuery q = lt_query_point(a + d * (0.5f * len), make_float3(0.0f, 0.0f, 0.0f));
+  q.len = -1.0f - 0.5f * len;
+  return q;
+}
+// The slack of a midpoint query (0 for a point or a segment query).
+#define LT_QUERY_SLACK(q) (HAS_MEDIUM && (q)->len < -1.0f ? -1.0f - (q)->len : 0.0f)
+
 // Whether q is a segment. Without HAS_MEDIUM (a kernel for a scene without media) this folds to 0
 // and the segment code is not compiled; a point query costs one well-predicted branch.
 #define LT_QUERY_IS_SEGMENT(q) (HAS_MEDIUM && (q)->len >= 0.0f)
