@@ -18,6 +18,9 @@
 //   a. an unbounded medium (the camera inside it), three lights;
 //   b. a bounded box the camera looks into from outside, the plane behind it, one light inside
 //      the box and one outside: the reference clips the camera ray and every light leg to the box.
+// The lights are just outside the frame (their light fills it): a light in view would make its
+// pixel's variance infinite (see lights_outside_the_frame). A 10% error in g or in the light legs'
+// transmittance fails both scenes (tried when the test was written).
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -30,6 +33,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -73,7 +77,7 @@ struct PointL {
 
 struct FogScene {
   std::string name;
-  V3 cam, look_at;
+  V3 cam, look_at, up{0, 0, 1};
   double fov;
   int width = 24, height = 16;
   Rgb albedo;
@@ -105,7 +109,7 @@ std::string scene_json(const FogScene& s, const std::string& sampler) {
   // The plane: 100 x 100 around the origin, facing +z (edge1 x edge2 = +z), larger than every
   // camera ray's footprint so that every ray ends on it.
   return fmt::format(
-      R"({{"camera": {{"position": {cam}, "look_at": {at}, "up": [0, 0, 1], "fov": {fov}}},
+      R"({{"camera": {{"position": {cam}, "look_at": {at}, "up": {up}, "fov": {fov}}},
           "film": {{"width": {w}, "height": {h}}},
           "integrator": {{"max_depth": 1, "light_sampler": "{sampler}"}},
           "medium": {{"sigma_a": {sa}, "sigma_s": {ss}, "g": {g}{bounds}}},
@@ -113,10 +117,11 @@ std::string scene_json(const FogScene& s, const std::string& sampler) {
           "shapes": [{{"type": "quad", "corner": [-50, -50, 0], "edge1": [100, 0, 0],
                        "edge2": [0, 100, 0], "material": "plane"}}],
           "lights": [{lights}]}})",
-      fmt::arg("cam", vec(s.cam)), fmt::arg("at", vec(s.look_at)), fmt::arg("fov", num(s.fov)),
-      fmt::arg("w", s.width), fmt::arg("h", s.height), fmt::arg("sampler", sampler),
-      fmt::arg("sa", rgb(s.sigma_a)), fmt::arg("ss", rgb(s.sigma_s)), fmt::arg("g", num(s.g)),
-      fmt::arg("bounds", bounds), fmt::arg("alb", rgb(s.albedo)), fmt::arg("lights", lights));
+      fmt::arg("cam", vec(s.cam)), fmt::arg("at", vec(s.look_at)), fmt::arg("up", vec(s.up)),
+      fmt::arg("fov", num(s.fov)), fmt::arg("w", s.width), fmt::arg("h", s.height),
+      fmt::arg("sampler", sampler), fmt::arg("sa", rgb(s.sigma_a)), fmt::arg("ss", rgb(s.sigma_s)),
+      fmt::arg("g", num(s.g)), fmt::arg("bounds", bounds), fmt::arg("alb", rgb(s.albedo)),
+      fmt::arg("lights", lights));
 }
 
 // ---------------------------------------------------------------- the exact answer
@@ -245,13 +250,16 @@ struct PixelRef {
 };
 
 // The pixel's box-filtered radiance: an n x n midpoint rule over its footprint with `panels`
-// panels per light; the error bound is |Q(n) - Q(n/2)| (footprint rule) plus |Q(panels) -
-// Q(panels/2)| on the n/2 grid (the equiangular integral).
+// panels per light, n doubled from 8 (up to 64) until |Q(n) - Q(n/2)| is below 1e-3 of the
+// pixel's value (the medium box's silhouette puts kinks into the image). The error bound is
+// |Q(n) - Q(n/2)| (the footprint rule) plus |Q(panels) - Q(panels/2)| on the n/2 grid (the
+// equiangular integral).
 PixelRef pixel_reference(const Med& m, const std::vector<PointL>& lights, const Rgb& albedo,
-                         const CameraParams& cam, int px, int py, int n, int panels) {
+                         const CameraParams& cam, int px, int py, int panels) {
   V3 o = v3(cam.origin), ll = v3(cam.lower_left), du = v3(cam.du), dv = v3(cam.dv);
   auto grid = [&](int k, int pan, Rgb* scatter) {
     Rgb acc{0, 0, 0};
+    if (scatter) *scatter = {0, 0, 0};
     for (int a = 0; a < k; ++a)
       for (int b = 0; b < k; ++b) {
         V3 d = ll + du * (px + (a + 0.5) / k) + dv * (py + (b + 0.5) / k);
@@ -265,10 +273,21 @@ PixelRef pixel_reference(const Med& m, const std::vector<PointL>& lights, const 
     return acc;
   };
   PixelRef p{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  p.L = grid(n, panels, &p.scatter);
-  Rgb half = grid(n / 2, panels, nullptr), coarse = grid(n / 2, panels / 2, nullptr);
+  // The equiangular rule's error is measured once, on a 4 x 4 grid.
+  const Rgb g4 = grid(4, panels, nullptr), g4_coarse = grid(4, panels / 2, nullptr);
+  Rgb half = g4;
+  for (int n = 8;; n *= 2) {
+    p.L = grid(n, panels, &p.scatter);
+    double diff = 0, top = 0;
+    for (int c = 0; c < 3; ++c) {
+      diff = std::max(diff, std::fabs(p.L[c] - half[c]));
+      top = std::max(top, p.L[c]);
+    }
+    if (diff <= 1e-3 * top || n == 64) break;
+    half = p.L;
+  }
   for (int c = 0; c < 3; ++c)
-    p.err[c] = std::fabs(p.L[c] - half[c]) + std::fabs(half[c] - coarse[c]);
+    p.err[c] = std::fabs(p.L[c] - half[c]) + std::fabs(g4[c] - g4_coarse[c]);
   return p;
 }
 
@@ -281,6 +300,26 @@ double bonferroni_k(double alpha, double m) {
     (std::erfc(mid / std::sqrt(2.0)) > alpha / m ? lo : hi) = mid;
   }
   return hi;
+}
+
+// Every light projects at least `margin` pixels outside the film. A light in view makes the
+// single scattering of the rays through its pixel diverge like 1/h (h the ray's distance to it):
+// the pixel's variance is then (logarithmically) infinite and its footprint integral converges
+// slowly, so neither the pixel's standard error nor its reference would be trustworthy.
+bool lights_outside_the_frame(const CameraParams& cam, const std::vector<PointL>& lights,
+                              double margin) {
+  V3 ll = v3(cam.lower_left), du = v3(cam.du), dv = v3(cam.dv);
+  V3 fwd = ll + du * (0.5 * cam.width) + dv * (0.5 * cam.height);
+  fwd = fwd * (1.0 / len(fwd));
+  for (const PointL& l : lights) {
+    V3 d = l.p - v3(cam.origin);
+    if (dot(d, fwd) <= 0) continue;      // behind the camera
+    V3 q = d * (1.0 / dot(d, fwd)) - ll; // on the image plane at distance 1
+    double x = dot(q, du) / dot(du, du), y = dot(q, dv) / dot(dv, dv);
+    if (x > -margin && x < cam.width + margin && y > -margin && y < cam.height + margin)
+      return false;
+  }
+  return true;
 }
 
 struct Outcome {
@@ -310,12 +349,18 @@ Outcome render_and_compare(ClRuntime& rt, const FogScene& s, const std::string& 
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
   CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
+  EXPECT_TRUE(lights_outside_the_frame(cam, lights, 2.0));
 
   const int W = film.width, H = film.height;
-  std::vector<PixelRef> ref(size_t(W) * H);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x)
-      ref[size_t(y) * W + x] = pixel_reference(m, lights, s.albedo, cam, x, y, 8, panels);
+  // The reference of a setup is the same for every sampler: computed once per test binary.
+  static std::map<std::string, std::vector<PixelRef>> cache;
+  std::vector<PixelRef>& ref = cache[s.name];
+  if (ref.empty()) {
+    ref.resize(size_t(W) * H);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x)
+        ref[size_t(y) * W + x] = pixel_reference(m, lights, s.albedo, cam, x, y, panels);
+  }
 
   // Pixel means and the variances of the means (from the film's second moments).
   std::vector<Rgb> mean(ref.size()), var(ref.size());
@@ -389,47 +434,50 @@ Outcome render_and_compare(ClRuntime& rt, const FogScene& s, const std::string& 
   // the medium's own light is a large part of the image (not a perturbation of the plane's).
   EXPECT_LT(total_bound, 0.01 * o.total_ref);
   EXPECT_LT(o.mean_rel_bound, 0.25);
-  EXPECT_GT(o.scatter_ref, 0.25 * o.total_ref);
+  EXPECT_GT(o.scatter_ref, 0.2 * o.total_ref);
   EXPECT_EQ(o.violations, 0);
   EXPECT_EQ(o.block_violations, 0);
   return o;
 }
 
-// a. Unbounded, the camera inside: coloured coefficients (red scatters least, blue absorbs
-// least), forward scattering, three lights of different colours and intensities in view.
+// a. Unbounded, the camera inside it looking down at the plane: coloured coefficients (red
+// scatters least, blue absorbs least), forward scattering, three lights of different colours and
+// intensities just outside the frame (see lights_outside_the_frame).
 FogScene unbounded_setup() {
   FogScene s;
   s.name = "unbounded";
-  s.cam = {0.4, -2.2, 2.6};
-  s.look_at = {0.0, 0.2, 0.3};
-  s.fov = 55;
+  s.cam = {0.1, -0.4, 3.0};
+  s.look_at = {0.2, 0.2, 0.0};
+  s.up = {0, 1, 0};
+  s.fov = 50;
   s.albedo = {0.7, 0.5, 0.35};
   s.sigma_a = {0.06, 0.1, 0.02};
   s.sigma_s = {0.25, 0.35, 0.5};
   s.g = 0.5;
-  s.lights = {{{0.5, 0.6, 0.5}, {3.0, 2.0, 1.0}},
-              {{-0.9, 0.1, 1.1}, {1.0, 2.5, 1.5}},
-              {{0.3, -0.8, 0.35}, {0.4, 0.5, 1.2}}};
+  s.lights = {{{2.0, 0.2, 1.0}, {3.0, 2.0, 1.0}},
+              {{-1.0, 1.6, 1.4}, {1.0, 2.5, 1.5}},
+              {{0.4, -1.8, 0.6}, {0.4, 0.5, 1.2}}};
   return s;
 }
 
-// b. A box of medium the camera looks into from outside; it reaches below the plane (so the plane
-// inside it is in the medium), the plane is seen through it and around it. One light inside the
-// box, one outside (its legs into the box are clipped); backward scattering.
+// b. A box of medium the camera looks into from outside: wider than the view (so a light inside
+// it can be out of the frame), reaching below the plane (so the plane inside it is in the
+// medium); the plane is seen through it and beyond it. One light inside the box, one outside
+// (its legs into the box are clipped); backward scattering.
 FogScene bounded_setup() {
   FogScene s;
   s.name = "bounded";
   s.cam = {0.3, -3.0, 2.4};
   s.look_at = {0.0, 0.0, 0.35};
-  s.fov = 50;
+  s.fov = 35;
   s.albedo = {0.6, 0.6, 0.45};
   s.sigma_a = {0.1, 0.25, 0.1};
   s.sigma_s = {0.9, 0.6, 0.45};
   s.g = -0.3;
   s.bounded = true;
-  s.bmin = {-0.8, -0.7, -0.2};
-  s.bmax = {0.9, 0.6, 1.0};
-  s.lights = {{{0.15, -0.1, 0.55}, {1.5, 1.2, 1.0}}, {{-1.4, 0.9, 1.3}, {2.0, 2.0, 3.0}}};
+  s.bmin = {-2.6, -0.7, -0.2};
+  s.bmax = {2.6, 0.6, 1.0};
+  s.lights = {{{2.0, 0.0, 0.5}, {1.5, 1.2, 1.0}}, {{-1.8, 1.2, 1.6}, {3.0, 3.0, 4.5}}};
   return s;
 }
 
@@ -478,9 +526,9 @@ TEST_P(MediumImage, PixelMeansMatchTheQuadrature) {
   ClRuntime rt;
   // The bounded box's light legs bend the integrand where they cross the box's faces: more panels.
   if (which == 0)
-    render_and_compare(rt, unbounded_setup(), sampler, 256, 8);
+    render_and_compare(rt, unbounded_setup(), sampler, 512, 8);
   else
-    render_and_compare(rt, bounded_setup(), sampler, 256, 32);
+    render_and_compare(rt, bounded_setup(), sampler, 512, 32);
 }
 
 INSTANTIATE_TEST_SUITE_P(UnboundedAndBounded, MediumImage,
