@@ -75,9 +75,9 @@ def write_obj(path, boxes):
         f.write("\n".join(lines) + "\n")
 
 
-# Ground fog of --fog: per metre; about 1/3 of the light is scattered or absorbed over 100 m, so
-# the far side of the city (400-600 m away, mostly above the layer) stays readable.
-FOG = {"sigma_a": 0.0005, "sigma_s": [0.0032, 0.0035, 0.004], "g": 0.4,
+# Ground fog of --fog: per metre; about 1/6 of the light is scattered or absorbed over 100 m, so
+# the streets under the glow of 3 x 10^5 lights and the far side of the city stay readable.
+FOG = {"sigma_a": 0.0003, "sigma_s": [0.0016, 0.00175, 0.002], "g": 0.4,
        "bounds": {"min": [-200, -1, -200], "max": [EXTENT + 200, 30, EXTENT + 200]}}
 
 
