@@ -104,9 +104,9 @@ protected:
     geometry_ = build_scene_geometry(scene_, materials_);
   }
   SceneBuffers scene_buffers() {
-    return SceneBuffers{geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
-                        geometry_.prims.data(), materials_.data(),
-                        geometry_.shading_normals.data()};
+    return SceneBuffers{geometry_.bvh.nodes.data(),       geometry_.bvh.prim_index.data(),
+                        geometry_.prims.data(),           materials_.data(),
+                        geometry_.shading_normals.data(), &scene_.medium}; // vacuum
   }
   bool occluded(float3 o, float3 d, float tmax) {
     Hit h;

@@ -162,7 +162,9 @@ protected:
       p.shade_P.push_back(make_float4(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng),
                                       i % 3 == 0 ? 0.0f : u(rng)));
       p.shade_N.push_back(f4_from3(normalize(make_float3(u(rng) - 0.5f, 1.0f, u(rng) - 0.5f)), 0));
-      p.shade_f.push_back(make_float4(0, 0, 0, 0));
+      // With a medium, some paths come from a medium vertex (MIS of the emission they find).
+      p.shade_f.push_back(
+          make_float4(0, 0, 0, scene_.has_medium && i % 4 == 1 ? VOLUME_POINT_FLAG : 0.0f));
       p.shade_wo.push_back(make_float4(0, 0, 0, 0));
       p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
       p.brdf_state.push_back(make_int4(0, 0, 0, 0));
@@ -170,6 +172,12 @@ protected:
       p.seg_o.push_back(make_float4(0, 0, 0, -1));
       p.seg_d.push_back(make_float4(0, 0, 0, 0));
       p.seg_beta.push_back(make_float4(0, 0, 0, 0));
+      p.seg_phase.push_back(0.0f);
+      // The segment of a previous medium vertex (for the MIS of emission found from it).
+      float3 so = make_float3(-2 + 4 * u(rng), 0.2f + 1.2f * u(rng), -2 + 4 * u(rng));
+      p.scatter_seg_o.push_back(f4_from3(so, 0.5f + 3 * u(rng)));
+      p.scatter_seg_d.push_back(
+          f4_from3(normalize(make_float3(u(rng) - 0.5f, u(rng) - 0.5f, 1)), 0.5f * u(rng)));
     }
     return p;
   }
@@ -279,6 +287,9 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
                       at + " seg_beta");
         ASSERT_EQ(float_as_uint_(dev.seg_beta[p].w), float_as_uint_(paths.seg_beta[p].w)) << at;
         ASSERT_EQ(dev.hits[p].prim, paths.hits[p].prim) << at;
+        ASSERT_EQ(dev.seg_phase[p], paths.seg_phase[p]) << at;
+        expect_close4(dev.scatter_seg_o[p], paths.scatter_seg_o[p], at + " scatter_seg_o");
+        expect_close4(dev.scatter_seg_d[p], paths.scatter_seg_d[p], at + " scatter_seg_d");
         scattered_seen += paths.hits[p].prim == HIT_SCATTERED;
       }
       segments_seen += segments;
@@ -604,7 +615,7 @@ INSTANTIATE_TEST_SUITE_P(Samplers, KernelStages,
                          ::testing::Values("uniform", "power", "tree", "tree-split", "exhaustive",
                                            "tree-noorient", "tree-split-noorient", "brdf-mis",
                                            "brdf-mis-equal", "brdf-oriented", "power-medium",
-                                           "tree-medium", "tree-split-medium", "brdf-mis-medium"),
+                                           "tree-split-medium", "brdf-mis-medium"),
                          [](const auto& p) {
                            std::string s = p.param;
                            for (char& c : s)

@@ -42,7 +42,14 @@
   /* xyz: its unit direction, w: the free-flight distance sampled along it (from its start) */     \
   X(float4, seg_d)                                                                                 \
   /* xyz: the path throughput at its start, w: the segment's light-pick seed (uint bits) */        \
-  X(float4, seg_beta)
+  X(float4, seg_beta)                                                                              \
+  /* 1 if the path continues from this segment's free-flight point with a phase-function ray */  \
+  /* and MIS is on (the segment's light samples are weighted against that technique), else 0 */  \
+  X(float, seg_phase)                                                                              \
+  /* The segment of the path's last medium vertex (shade_P), for MIS at the next hit: */          \
+  /* xyz: its start, w: its length; and xyz: its direction, w: the vertex's distance along it */  \
+  X(float4, scatter_seg_o)                                                                         \
+  X(float4, scatter_seg_d)
 
 // The scene's buffers, likewise: X(element type, name), read-only on the device.
 #define SCENE_BUFFERS(X)                                                                           \

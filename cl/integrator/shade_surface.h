@@ -22,12 +22,14 @@
 
 // MIS weight of emission found by a BSDF-sampled ray (DESIGN §5). prev_P.w is the solid-angle pdf
 // of the BSDF direction, 0 for a delta bounce.
-INLINE float shade_emission_weight(const LightSamplerCtx* ls, const PathBuffers* pb, int path,
-                                   int depth, int light, float3 P) {
+INLINE float shade_emission_weight(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                                   const PathBuffers* pb, int path, int depth, int light,
+                                   float3 P) {
   float4 prev_P = pb->shade_P[path];
   if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
-  // A medium vertex has its direct light complete without its phase-function ray (volume_light.h)
-  if (HAS_MEDIUM && pb->shade_f[path].w == VOLUME_POINT_FLAG) return 0.0f;
+  // A medium vertex: the phase technique against the segment's light samples (volume_light.h).
+  if (HAS_MEDIUM && pb->shade_f[path].w == VOLUME_POINT_FLAG)
+    return CANOPY_MIS ? volume_emission_weight(ls, sc, pb, path, light, P) : 0.0f;
   // A glossy point of a BRDF sampler has its direct light complete without its bounce (brdf_mis.h)
   if (HAS_MICROFACET && light_sampler_brdf(ls) && pb->shade_f[path].w == BRDF_POINT_FLAG)
     return 0.0f;
@@ -66,7 +68,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
 
   if (prim->light >= 0) {
     float3 Le = light_emitted_radiance(&ls->lights[prim->light], Ng, -d);
-    float w = shade_emission_weight(ls, pb, path, depth, prim->light, P);
+    float w = shade_emission_weight(ls, sc, pb, path, depth, prim->light, P);
     float4 L = pb->radiance[path];
     pb->radiance[path] = f4_from3(xyz_of(L) + beta * Le * w, 0.0f);
   }

@@ -60,8 +60,9 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
   pb->seg_o[path] = f4_from3(a, lights ? len : -1.0f);
   pb->seg_d[path] = f4_from3(d, t_free);
   pb->seg_beta[path] = f4_from3(beta, uint_as_float_(seed));
-
   int continues = depth + 1 < max_depth;
+  pb->seg_phase[path] = continues && CANOPY_MIS ? 1.0f : 0.0f;
+
   if (continues && t_free < len) {
     // Scatter at the free-flight point (Tr sigma_s / pdf <= 3 per channel: channel MIS).
     float3 x = a + d * t_free;
@@ -77,19 +78,27 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
     Hit hs = h;
     hs.prim = alive && pdf > 0.0f ? HIT_SCATTERED : -1; // -1: the path ends here
     pb->hits[path] = hs;
-    // The vertex for MIS at the next hit: emission found from it is not counted (volume_light.h).
+    // The vertex and its segment, for MIS at the next hit (volume_emission_weight).
     pb->shade_P[path] = f4_from3(x, pdf);
+    pb->scatter_seg_o[path] = f4_from3(a, len);
+    pb->scatter_seg_d[path] = f4_from3(d, t_free);
     pb->shade_f[path] = f4_from3(beta, VOLUME_POINT_FLAG);
     pb->ray_o[path] = f4_from3(x, 0.0f);
     pb->ray_d[path] = f4_from3(wi, 0.0f);
     pb->throughput[path] = f4_from3(beta, 0.0f);
     return lights;
   }
-  // The path reaches its hit (an escaped ray has nothing left to weight).
+  // The path reaches its hit (an escaped ray has nothing left to weight); nothing reaches it
+  // through a medium that dense: the path ends.
   if (h.prim >= 0) {
     float3 tr = medium_tr(&m, full);
     if (continues) tr = tr * (1.0f / medium_survival(&m, full));
-    pb->throughput[path] = f4_from3(beta * tr, 0.0f);
+    beta = beta * tr;
+    pb->throughput[path] = f4_from3(beta, 0.0f);
+    if (!(max3(beta) > 0.0f)) {
+      h.prim = -1;
+      pb->hits[path] = h;
+    }
   }
   return lights;
 }

@@ -7,9 +7,13 @@
 // segment (the distance sample shade_volume drew), each MIS-weighted against the other technique
 // (power heuristic over their densities in t; both then sample the light from their point).
 //
-// Emission that a phase-function ray finds is not counted (shade_surface.h): this estimate covers
-// the direct light of every medium vertex. Canopy samples area lights by solid angle, so the
-// phase-function technique would add little but a third pdf to every weight.
+// A path that continues from the segment's free-flight point with a phase-function ray is a third
+// technique for the same integral (free-flight t, phase direction), which finds area lights: all
+// three are combined with the power heuristic over their densities in (t, direction), per light:
+//   equiangular:  pmf * pdf_eq(t) * pdf_light(w)      free flight:  pmf * pdf_ff(t) * pdf_light(w)
+//   phase:        pdf_ff(t) * p(w)
+// (volume_light_item for the light samples, volume_emission_weight for emitters found by phase
+// rays). On a path's last vertex no phase ray leaves, and the light samples use two techniques.
 //
 // Compiles as OpenCL C and as C++.
 #ifndef CANOPY_INTEGRATOR_VOLUME_LIGHT_H
@@ -34,14 +38,25 @@
 #define CANOPY_VOLUME_MIDPOINT 0 // 1: rank clusters by the surface importance at the midpoint
 #endif
 
-// The light-pick query of the path's segment: the segment itself (Eq. 7), or under the ablation
-// its midpoint as a point without a normal (the surface importance, Eq. 3, without cos theta_i,
-// with bounds grown by half the segment so that it stays conservative: query.h).
-INLINE LtQuery volume_query(const PathBuffers* pb, int path) {
-  float4 o = pb->seg_o[path];
-  float4 d = pb->seg_d[path];
+// The light-pick query of a segment (start o.xyz, length o.w, direction d.xyz): the segment itself
+// (Eq. 7), or under the ablation its midpoint as a point without a normal (the surface importance,
+// Eq. 3, without cos theta_i, with bounds grown by half the segment so that it stays
+// conservative: query.h).
+INLINE LtQuery volume_query_of(float4 o, float4 d) {
   if (CANOPY_VOLUME_MIDPOINT) return lt_query_midpoint(xyz_of(o), xyz_of(d), o.w);
   return lt_query_segment(xyz_of(o), xyz_of(d), o.w);
+}
+INLINE LtQuery volume_query(const PathBuffers* pb, int path) {
+  return volume_query_of(pb->seg_o[path], pb->seg_d[path]);
+}
+
+// Power heuristic of technique a against b and c (densities >= 0, 0 for a technique that cannot
+// make the sample), from ratios to the largest so that it neither overflows nor divides 0 by 0.
+INLINE float power_heuristic3(float pa, float pb, float pc) {
+  if (!(pa > 0.0f)) return 0.0f;
+  float m = fmax(pa, fmax(pb, pc));
+  float a = pa / m, b = pb / m, c = pc / m;
+  return a * a / (a * a + b * b + c * c);
 }
 
 // Where equiangular sampling aims for a light: its position (point, spot; exact) or the centre of
@@ -60,12 +75,14 @@ INLINE float3 volume_transmittance(const SceneBuffers* sc, float3 o, float3 d, f
   return medium_transmittance(&m, o, d, tmax);
 }
 
-// The shadow item of a light sampled from the segment's point at distance t: beta Tr(t) sigma_s
-// p(theta) Li Tr(leg) times `weight` (the MIS weight over the density of t) / (pmf pdf(wi)).
-// Returns 1 if an item was written.
+// The shadow item of a light sampled from the segment's point at distance t, chosen with density
+// p_t by one technique in t (p_other: the other's density there): beta Tr(t) sigma_s p(theta) Li
+// Tr(leg) w / (p_t pmf pdf(wi)), w the power heuristic against the other technique and, when
+// `phase_mis`, against the phase-function technique. Returns 1 if an item was written.
 INLINE int volume_light_item(const Medium* m, const LightSamplerCtx* ls, int path, float3 a,
-                             float3 d, float t, float weight, float3 beta, int light, float pmf,
-                             float u1, float u2, GLOBAL ShadowItem* out) {
+                             float3 d, float t, float p_t, float p_other, int phase_mis,
+                             float3 beta, int light, float pmf, float u1, float u2,
+                             GLOBAL ShadowItem* out) {
   float3 x = a + d * t;
   LightSample s = sample_light(&ls->lights[light], x, u1, u2);
   if (!(s.pdf > 0.0f) || !(max3(s.Li) > 0.0f)) return 0;
@@ -76,6 +93,11 @@ INLINE int volume_light_item(const Medium* m, const LightSamplerCtx* ls, int pat
   float tmax = fmax(dist - fp_gamma(6) * (max_abs3(s.x) + dist), 0.0f);
   float3 tr = medium_tr(m, t) * medium_transmittance(m, x, dir, tmax);
   float phase = phase_hg(m->sigma_t.w, dot(s.wi, d));
+  // The phase technique's density in the same units (divided by pmf pdf(wi)); it never finds a
+  // point or spot light.
+  float p_phase =
+      phase_mis && !s.is_delta ? medium_distance_pdf(m, t) * (phase / (pmf * s.pdf)) : 0.0f;
+  float weight = power_heuristic3(p_t, p_other, p_phase) / p_t;
   float3 c = beta * tr * xyz_of(m->sigma_s) * s.Li * (phase * weight / (pmf * s.pdf));
   // Non-finite contributions are kept (accumulate counts them), zero ones dropped.
   if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) return 0;
@@ -100,24 +122,42 @@ INLINE int volume_shadow_items(const LightSamplerCtx* ls, const SceneBuffers* sc
   float3 beta = xyz_of(pb->seg_beta[path]);
   float3 a = xyz_of(so), d = xyz_of(sd);
   float len = so.w, t_free = sd.w;
+  int phase_mis = pb->seg_phase[path] > 0.0f;
   float3 c = light_center(&ls->lights[light]);
   int n = 0;
   // Equiangular sampling towards the light (exact for point lights: pdf ~ 1 / |x(t) - c|^2).
   float p_eq = 0.0f;
   float t_eq = equiangular_sample(a, d, len, c, u0, &p_eq);
-  if (p_eq > 0.0f) {
-    float w = power_heuristic(p_eq, medium_distance_pdf(&m, t_eq)) / p_eq;
-    n += volume_light_item(&m, ls, path, a, d, t_eq, w, beta, light, pmf, u1, u2, out + n);
-  }
+  if (p_eq > 0.0f)
+    n += volume_light_item(&m, ls, path, a, d, t_eq, p_eq, medium_distance_pdf(&m, t_eq), phase_mis,
+                           beta, light, pmf, u1, u2, out + n);
   // The free-flight point, if it falls on the segment.
   if (t_free < len) {
     float p_ff = medium_distance_pdf(&m, t_free);
-    if (p_ff > 0.0f) {
-      float w = power_heuristic(p_ff, equiangular_pdf(a, d, len, c, t_free)) / p_ff;
-      n += volume_light_item(&m, ls, path, a, d, t_free, w, beta, light, pmf, u3, u4, out + n);
-    }
+    if (p_ff > 0.0f)
+      n +=
+          volume_light_item(&m, ls, path, a, d, t_free, p_ff, equiangular_pdf(a, d, len, c, t_free),
+                            phase_mis, beta, light, pmf, u3, u4, out + n);
   }
   return n;
+}
+
+// MIS weight of the emission that a phase-function ray from the path's last medium vertex (at
+// distance t along its segment, shade_P.xyz, phase density shade_P.w) finds at point y of `light`:
+// the phase technique against the segment's two light-sampling techniques for that light.
+INLINE float volume_emission_weight(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                                    const PathBuffers* pb, int path, int light, float3 y) {
+  Medium m = sc->medium[0];
+  float4 so = pb->scatter_seg_o[path];
+  float4 sd = pb->scatter_seg_d[path];
+  float4 x = pb->shade_P[path];
+  float t = sd.w;
+  LtQuery q = volume_query_of(so, sd);
+  float p_ff = medium_distance_pdf(&m, t);
+  float p_light = light_sampler_pmf_q(ls, &q, light) * light_pdf(&ls->lights[light], xyz_of(x), y);
+  float3 c = light_center(&ls->lights[light]);
+  float p_eq = equiangular_pdf(xyz_of(so), xyz_of(sd), so.w, c, t);
+  return power_heuristic3(p_ff * x.w, p_eq * p_light, p_ff * p_light);
 }
 
 #endif // CANOPY_INTEGRATOR_VOLUME_LIGHT_H
