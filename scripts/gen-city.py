@@ -3,6 +3,13 @@
 docs/results.md (Conty Estevez & Kulla 2018, Fig. 1 and 14, at a size that renders here).
 
     python3 scripts/gen-city.py            # rewrites both files (deterministic)
+    python3 scripts/gen-city.py --fog      # also writes scenes/city-fog.json (issue 13)
+
+--fog: scenes/city-fog.json is city.json with a homogeneous medium added and nothing else
+changed (the paper's Fig. 1 renders the city in participating media): a layer of thin ground fog,
+a box over the whole ground 30 m deep. The camera, 46 m up, looks into it from above (the
+bounded-medium case). The street lamps, the cars and the lower windows are inside the layer,
+the upper windows of the towers above it.
 
 A 16 x 16 grid of blocks (blocks 24 m, streets 10 m) with 2 x 2 buildings per block (one OBJ,
 flat roofs, 1024 boxes). Lights, about 3 x 10^5 in all:
@@ -12,6 +19,7 @@ flat roofs, 1024 boxes). Lights, about 3 x 10^5 in all:
   * cars: point lights 0.7 m above the streets, random, white and red.
 Only the standard library; Python's random module is deterministic for a given seed.
 """
+import argparse
 import json
 import os
 import random
@@ -67,7 +75,13 @@ def write_obj(path, boxes):
         f.write("\n".join(lines) + "\n")
 
 
-def scene(boxes, rng):
+# Ground fog of --fog: per metre; about 1/6 of the light is scattered or absorbed over 100 m, so
+# the streets under the glow of 3 x 10^5 lights and the far side of the city stay readable.
+FOG = {"sigma_a": 0.0003, "sigma_s": [0.0016, 0.00175, 0.002], "g": 0.4,
+       "bounds": {"min": [-200, -1, -200], "max": [EXTENT + 200, 30, EXTENT + 200]}}
+
+
+def scene(boxes, rng, fog=False):
     lamps = []
     cars = []
     n_streets = BLOCKS + 1
@@ -101,12 +115,16 @@ def scene(boxes, rng):
         "// One indirect bounce (max_depth 2). Units: metres. Format: docs/scene-format.md.\n"
         % (len(boxes), n_lights, WINDOWS, sum(l["nx"] * l["ny"] for l in lamps),
            sum(c["count"] for c in cars)))
+    if fog:
+        head += ("// city-fog: city.json with a layer of ground fog 30 m deep over the whole ground\n"
+                 "// (a bounded homogeneous medium; the camera looks into it from above).\n")
     doc = {
         "camera": {"position": [EXTENT * 0.5 - 30, 46, -40],
                    "look_at": [EXTENT * 0.5 + 12, 0, EXTENT * 0.45], "up": [0, 1, 0], "fov": 50},
         "film": {"width": 480, "height": 270},
         "integrator": {"spp": 16, "max_depth": 2, "light_sampler": "tree-split",
                        "split_threshold": 0.85, "seed": 1},
+        **({"medium": FOG} if fog else {}),
         "materials": [{"name": "asphalt", "albedo": 0.12},
                       {"name": "concrete", "albedo": [0.45, 0.43, 0.4]}],
         "shapes": [
@@ -124,6 +142,10 @@ def scene(boxes, rng):
 
 
 def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--fog", action="store_true",
+                    help="also write scenes/city-fog.json (the same city in ground fog)")
+    args = ap.parse_args()
     rng = random.Random(2018)
     boxes = buildings(rng)
     os.makedirs(os.path.join(ROOT, "scenes", "city"), exist_ok=True)
@@ -131,6 +153,10 @@ def main():
     with open(os.path.join(ROOT, "scenes", "city.json"), "w") as f:
         f.write(scene(boxes, rng))
     print("wrote scenes/city.json and scenes/city/buildings.obj")
+    if args.fog:
+        with open(os.path.join(ROOT, "scenes", "city-fog.json"), "w") as f:
+            f.write(scene(boxes, rng, fog=True))
+        print("wrote scenes/city-fog.json")
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@
 #   SCENES="spiral-10k city" ./scripts/make-results.sh   # a subset (the report covers what exists)
 #   SCENES="glossy-cornell showroom" ./scripts/make-results.sh   # the glossy scenes (issues 11-12)
 #   SCENES="glossy-cornell showroom default scalability" ./scripts/make-results.sh   # issue 12
+#   SCENES="spiral-fog city-fog" ./scripts/make-results.sh   # participating media (issue 13)
 #   CANOPY=path/to/canopy SKIP_BUILD=1 ./scripts/make-results.sh
 #   # A dry run of the machinery (meaningless numbers, nothing under docs/ touched):
 #   BUDGET=1 REF_SPP=16 SEEDS=1 DOCS=/tmp/r REPORT=/tmp/r.md SCENES=plane-10k ./scripts/make-results.sh
@@ -24,7 +25,7 @@
 # Environment: SCENES, BUILD, CANOPY, SKIP_BUILD; BUDGET and REF_SPP override every scene's budget
 # and reference spp; SEEDS (3); WORK (out/results), DOCS (docs/results) and REPORT
 # (docs/results.md) move the outputs; SAMPLERS_MANY, SAMPLERS_GLOSSY and SAMPLERS_DIFFUSE replace
-# the sampler sets; REUSE_REFERENCE=1 keeps a reference already in $WORK (same scene, film scale
+# the sampler sets (SAMPLERS_FOG: the media scenes of issue 13); REUSE_REFERENCE=1 keeps a reference already in $WORK (same scene, film scale
 # and reference sampler: the caller's responsibility) instead of rendering it again. Scalability:
 # SCALE_COUNTS (light counts, "1000 10000 100000"), SCALE_SPP (8), SCALE_REPS (3), SCALE_FILM
 # (film scale, 0.5 = 128 x 128), SCALE_SAMPLERS ("brdf-mis,tree-split").
@@ -56,6 +57,11 @@ mkdir -p "$WORK" "$DOCS"
 SAMPLERS_MANY=${SAMPLERS_MANY:-uniform,power,tree,tree-noorient,tree-split:0.0,tree-split:0.25,tree-split:0.5,tree-split:0.85,tree-split:0.95}
 SAMPLERS_GLOSSY=${SAMPLERS_GLOSSY:-tree-split,tree-split/nomis,power,power/nomis,bsdf,brdf-mis,brdf-oriented,brdf-mis/equal,brdf-mis:0.005,brdf-mis:0.05,brdf-mis:0.1,brdf-mis:0.3,brdf-mis:0.7}
 SAMPLERS_DIFFUSE=${SAMPLERS_DIFFUSE:-tree-split,brdf-mis}
+# "fog": the participating-media scenes of issue 13 (Conty Estevez & Kulla 2018, §5.2): power
+# sampling, the tree with and without splitting, each with the segment importance of ray
+# segments (Eq. 7, the default) and with the surface importance at the segment's midpoint
+# (/midpoint, the ablation).
+SAMPLERS_FOG=${SAMPLERS_FOG:-power,tree,tree/midpoint,tree-split,tree-split/midpoint}
 SCALE_COUNTS=${SCALE_COUNTS:-"1000 10000 100000"}
 SCALE_SPP=${SCALE_SPP:-8}
 SCALE_REPS=${SCALE_REPS:-3}
@@ -87,8 +93,10 @@ plane-10k      | 1    | 20 | tree       | 1024 | 0 | many
 glossy-cornell | 0.5  | 20 | power      | 2048 | 1 | glossy
 showroom       | 0.5  | 20 | tree-split | 1024 | 0 | glossy
 default        | 0.5  | 20 | tree-split | 1024 | 1 | diffuse
+spiral-fog     | 0.5  | 20 | tree-split | 512  | 1 | fog
+city-fog       | 0.5  | 20 | tree-split | 512  | 0 | fog
 "
-SCENES=${SCENES:-"spiral-10k cornell-1m city mesh-light plane-10k glossy-cornell showroom default scalability"}
+SCENES=${SCENES:-"spiral-10k cornell-1m city mesh-light plane-10k glossy-cornell showroom default scalability spiral-fog city-fog"}
 
 has_heatmap=0
 if "$CANOPY" render --help 2>/dev/null | grep -q -- "--heatmap"; then has_heatmap=1; fi
@@ -130,6 +138,7 @@ for name in $SCENES; do
     many) samplers=$SAMPLERS_MANY ;;
     glossy) samplers=$SAMPLERS_GLOSSY ;;
     diffuse) samplers=$SAMPLERS_DIFFUSE ;;
+    fog) samplers=$SAMPLERS_FOG ;;
     *) echo "make-results: scene $name: unknown sampler set '$set'" >&2; exit 2 ;;
   esac
   clamp_opt=()
@@ -157,6 +166,15 @@ for name in $SCENES; do
   if [ "$has_heatmap" = 1 ]; then
     "$CANOPY" render "$scene" --spp 1 --light-sampler tree-split --out "$WORK/$name-heat.exr" \
       --png "$WORK/$name-heat.png" --heatmap "$DOCS/$name-heatmap.png" >/dev/null
+  fi
+  # Media: shadow rays per ray segment and per surface point (the paper's Fig. 1: "7 shadow rays
+  # per shading point, 45 for the volume integral"), tree-split with either segment ranking, at
+  # the scene's film and spp.
+  if [ "$set" = fog ]; then
+    for vi in segment midpoint; do
+      "$CANOPY" render "$scene" --light-sampler tree-split --volume-importance "$vi" \
+        --out "$WORK/$name-stats-$vi.exr" --stats-json "$DOCS/$name-stats-$vi.json" >/dev/null
+    done
   fi
   echo "== $name done, $(( $(date +%s) - start )) s so far" >&2
 done
