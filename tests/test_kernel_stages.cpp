@@ -752,15 +752,18 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
   const int n = 5000, block = 256;
   std::mt19937 rng(8);
   std::vector<int2> counts(n);
+  // The program has every feature (media too): LIGHT_PICK_SHADOW_SLOTS shadow slots per item.
+  const int slots = LIGHT_PICK_SHADOW_SLOTS;
   std::vector<SplitItem> child(4 * n);
-  std::vector<ShadowItem> shadow(4 * n);
+  std::vector<ShadowItem> shadow(size_t(slots) * n);
   for (int i = 0; i < n; ++i) {
-    int c = int(rng() % 5), s = c ? 0 : int(rng() % 5);
+    int c = int(rng() % 5), s = c ? 0 : int(rng() % (slots + 1));
     counts[size_t(i)] = make_int2(c, s);
-    for (int j = 0; j < 4; ++j) {
+    for (int j = 0; j < 4; ++j)
       child[size_t(4 * i + j)] = SplitItem{make_float4(0, 0, 0, 1), i / 3, 10 * i + j, 1u, 0.0f};
-      shadow[size_t(4 * i + j)].dir = make_float4(0, 0, 1, uint_as_float_(uint(i / 3)));
-      shadow[size_t(4 * i + j)].contribution = make_float4(float(i), float(j), 1, 0);
+    for (int j = 0; j < slots; ++j) {
+      shadow[size_t(slots * i + j)].dir = make_float4(0, 0, 1, uint_as_float_(uint(i / 3)));
+      shadow[size_t(slots * i + j)].contribution = make_float4(float(i), float(j), 1, 0);
     }
   }
   int blocks = (n + block - 1) / block;
@@ -788,7 +791,7 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
     for (int j = 0; j < counts[size_t(i)].x; ++j)
       ref_split.push_back(child[size_t(4 * i + j)]);
     for (int j = 0; j < counts[size_t(i)].y; ++j)
-      ref_shadow.push_back(shadow[size_t(4 * i + j)]);
+      ref_shadow.push_back(shadow[size_t(slots * i + j)]);
   }
   ASSERT_EQ(tot[0], int(ref_split.size()));
   ASSERT_EQ(tot[1], int(ref_shadow.size()));
