@@ -24,9 +24,10 @@
 #
 # Environment: SCENES, BUILD, CANOPY, SKIP_BUILD; BUDGET and REF_SPP override every scene's budget
 # and reference spp; SEEDS (3); WORK (out/results), DOCS (docs/results) and REPORT
-# (docs/results.md) move the outputs; SAMPLERS_MANY, SAMPLERS_GLOSSY and SAMPLERS_DIFFUSE replace
-# the sampler sets (SAMPLERS_FOG: the media scenes of issue 13); REUSE_REFERENCE=1 keeps a reference already in $WORK (same scene, film scale
-# and reference sampler: the caller's responsibility) instead of rendering it again. Scalability:
+# (docs/results.md) move the outputs; SAMPLERS_MANY, SAMPLERS_GLOSSY, SAMPLERS_DIFFUSE and
+# SAMPLERS_FOG (the media scenes of issue 13) replace the sampler sets; REUSE_REFERENCE=1 keeps a
+# reference already in $WORK (same scene, film scale and reference sampler: the caller's
+# responsibility) instead of rendering it again. Scalability:
 # SCALE_COUNTS (light counts, "1000 10000 100000"), SCALE_SPP (8), SCALE_REPS (3), SCALE_FILM
 # (film scale, 0.5 = 128 x 128), SCALE_SAMPLERS ("brdf-mis,tree-split"). FOG_STATS_SPP (4): spp of
 # the fog scenes' --stats renders (shadow rays per segment and per surface point).
@@ -58,8 +59,8 @@ mkdir -p "$WORK" "$DOCS"
 # "fog": spiral-fog and city-fog (issue 13; SAMPLERS_FOG below). spiral-fog clamps for the same
 # reason as cornell-1m (its emissive tube is in view, a few pixels wide); city-fog's lights are
 # points (unseen). Their references are tree-split (the renderer's default); city-fog's film is
-# quartered (its tree-split costs about 10 s per spp at full size
-# with ~46 shadow rays per ray segment).
+# quartered (its tree-split costs about 10 s per spp at full size with ~46 shadow rays per ray
+# segment).
 SAMPLERS_MANY=${SAMPLERS_MANY:-uniform,power,tree,tree-noorient,tree-split:0.0,tree-split:0.25,tree-split:0.5,tree-split:0.85,tree-split:0.95}
 SAMPLERS_GLOSSY=${SAMPLERS_GLOSSY:-tree-split,tree-split/nomis,power,power/nomis,bsdf,brdf-mis,brdf-oriented,brdf-mis/equal,brdf-mis:0.005,brdf-mis:0.05,brdf-mis:0.1,brdf-mis:0.3,brdf-mis:0.7}
 SAMPLERS_DIFFUSE=${SAMPLERS_DIFFUSE:-tree-split,brdf-mis}
@@ -67,7 +68,8 @@ SAMPLERS_DIFFUSE=${SAMPLERS_DIFFUSE:-tree-split,brdf-mis}
 # sampling, the tree with and without splitting, each with the segment importance of ray
 # segments (Eq. 7, the default) and with the surface importance at the segment's midpoint
 # (/midpoint, the ablation).
-SAMPLERS_FOG=${SAMPLERS_FOG:-power,tree,tree/midpoint,tree-split,tree-split/midpoint}
+# tree-split runs at the scene's threshold (0.85, as city.json) and at the default (0.25).
+SAMPLERS_FOG=${SAMPLERS_FOG:-power,tree,tree/midpoint,tree-split,tree-split/midpoint,tree-split:0.25,tree-split:0.25/midpoint}
 SCALE_COUNTS=${SCALE_COUNTS:-"1000 10000 100000"}
 SCALE_SPP=${SCALE_SPP:-8}
 SCALE_REPS=${SCALE_REPS:-3}
@@ -162,6 +164,16 @@ for name in $SCENES; do
   fi
   echo "== $name: reference $ref_sampler x $ref_spp spp, film scale $scale, budget $budget s," \
     "samplers $samplers" >&2
+  # The fog scenes' report quotes its exact command lines ($DOCS/$name-commands.txt).
+  if [ "$set" = fog ]; then
+    echo "canopy converge $scene --film-scale $scale ${clamp_opt[*]} --reference" \
+      "$WORK/$name-ref.exr ${ref_opt[*]} --samplers $samplers --budget $budget --seeds $SEEDS" \
+      "--out $DOCS/$name" | tr -s ' ' >"$DOCS/$name-commands.txt"
+    if [ ${#ref_opt[@]} = 0 ]; then
+      echo "# (REUSE_REFERENCE: $WORK/$name-ref.exr is from an earlier run of this script, made" \
+        "with --reference-sampler $ref_sampler --reference-spp $ref_spp)" >>"$DOCS/$name-commands.txt"
+    fi
+  fi
   "$CANOPY" converge "$scene" --film-scale "$scale" "${clamp_opt[@]}" \
     --reference "$WORK/$name-ref.exr" "${ref_opt[@]}" --samplers "$samplers" \
     --budget "$budget" --seeds "$SEEDS" --out "$DOCS/$name" | tee "$WORK/$name-converge.txt"
@@ -178,11 +190,19 @@ for name in $SCENES; do
   # per shading point, 45 for the volume integral"), tree-split with either segment ranking, at
   # the scene's film and FOG_STATS_SPP spp (averages over 10^5-10^6 segments: more spp would not
   # change them).
+  # Both segment rankings at the scene's threshold, and the segment importance at the default
+  # threshold (0.25; stats-segment-0.25.json).
   if [ "$set" = fog ]; then
-    for vi in segment midpoint; do
-      "$CANOPY" render "$scene" --spp "$FOG_STATS_SPP" --light-sampler tree-split \
-        --volume-importance "$vi" --out "$WORK/$name-stats-$vi.exr" \
-        --stats-json "$DOCS/$name-stats-$vi.json" >/dev/null
+    for run in segment midpoint segment:0.25; do
+      vi=${run%%:*}
+      thr_opt=() tag=$vi
+      if [ "$run" != "$vi" ]; then thr_opt=(--split-threshold "${run#*:}") tag=$vi-${run#*:}; fi
+      "$CANOPY" render "$scene" --spp "$FOG_STATS_SPP" --light-sampler tree-split "${thr_opt[@]}" \
+        --volume-importance "$vi" --out "$WORK/$name-stats-$tag.exr" \
+        --stats-json "$DOCS/$name-stats-$tag.json" >/dev/null
+      echo "canopy render $scene --spp $FOG_STATS_SPP --light-sampler tree-split ${thr_opt[*]}" \
+        "--volume-importance $vi --out $WORK/$name-stats-$tag.exr --stats-json" \
+        "$DOCS/$name-stats-$tag.json" | tr -s ' ' >>"$DOCS/$name-commands.txt"
     done
   fi
   echo "== $name done, $(( $(date +%s) - start )) s so far" >&2
