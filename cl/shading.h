@@ -107,4 +107,14 @@ INLINE float max_abs3(float3 v) {
   return fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
 }
 
+// Russian roulette from a path's third vertex on (depth >= 2): it survives with probability
+// q = min(max(beta), 0.95) and then carries beta / q. Returns 0 if the path ends.
+INLINE int russian_roulette(float3* beta, int depth, float u) {
+  if (depth < 2) return 1;
+  float q = fmin(max3(*beta), 0.95f);
+  if (u >= q) return 0;
+  *beta = *beta / q;
+  return 1;
+}
+
 #endif // CANOPY_CL_SHADING_H

@@ -27,6 +27,7 @@
 // half-vector mapping. Each chi-square test passes when its p-value is above 0.01 / kChi2Tests
 // (Bonferroni over all of them). 10^5 samples per case.
 #include "bsdf/bsdf.h"
+#include "support/gamma_q.h"
 #include "support/materials.h"
 
 #include <gtest/gtest.h>
@@ -230,36 +231,7 @@ std::vector<std::pair<double, double>> valid_phi(D3 wo, double theta, double pa,
 }
 
 // ---------------------------------------------------------------- chi-square
-// Regularised upper incomplete gamma Q(a, x) (series below a + 1, Lentz's continued fraction
-// above).
-double gamma_q(double a, double x) {
-  if (x <= 0) return 1;
-  double gln = std::lgamma(a);
-  if (x < a + 1) {
-    double ap = a, sum = 1 / a, del = sum;
-    for (int n = 0; n < 100000; ++n) {
-      ap += 1;
-      del *= x / ap;
-      sum += del;
-      if (std::fabs(del) < std::fabs(sum) * 1e-15) break;
-    }
-    return std::max(0.0, 1 - sum * std::exp(-x + a * std::log(x) - gln));
-  }
-  double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    double an = -i * (i - a);
-    b += 2;
-    d = an * d + b;
-    if (std::fabs(d) < 1e-300) d = 1e-300;
-    c = b + an / c;
-    if (std::fabs(c) < 1e-300) c = 1e-300;
-    d = 1 / d;
-    double del = d * c;
-    h *= del;
-    if (std::fabs(del - 1) < 1e-15) break;
-  }
-  return std::exp(-x + a * std::log(x) - gln) * h;
-}
+using canopy::test::gamma_q;
 
 struct Chi2Result {
   double chi2 = 0, p = 1;

@@ -87,15 +87,7 @@ TEST(LightTreeSampling, PmfSumsToOne) {
 // leaf) the pmf is exactly E_l / d_l^2 normalised, whatever the normal and the spots' axes; the
 // full measure gives lights that face away or lie behind the horizon probability 0.
 TEST(LightTreeSampling, OrientationAblationRanksByEnergyOverDistanceSquared) {
-  std::vector<Light> lights = {make_spot_light(make_float3(1, 2, 0), make_float3(0, -1, 0), 0.8f,
-                                               0.9f, make_float3(3, 3, 3)),
-                               make_spot_light(make_float3(-2, 1, 1), make_float3(0, 1, 0), 0.8f,
-                                               0.9f, make_float3(1, 1, 1)),
-                               make_spot_light(make_float3(0, -1, 3), make_float3(1, 0, 0), 0.5f,
-                                               0.7f, make_float3(2, 1, 1)),
-                               make_spot_light(make_float3(4, 3, -2),
-                                               make_float3(-1, -1, 0) / std::sqrt(2.0f), 0.9f,
-                                               0.95f, make_float3(5, 4, 4))};
+  std::vector<Light> lights = four_spot_lights();
   LightSamplerOptions off;
   off.orientation = false;
   auto ablation = make_light_sampler("tree", lights, off);

@@ -509,15 +509,7 @@ TEST(LightTreeSegment, PointQueriesEqualPointForms) {
 // lights (radius 0, one per lane of the root) get pmf E_l / d_l normalised, d_l the distance from
 // light l to the segment, whatever their axes; the full measure culls the spots facing away.
 TEST(LightTreeSegment, OrientationAblationRanksByEnergyOverDistance) {
-  std::vector<Light> lights = {make_spot_light(make_float3(1, 2, 0), make_float3(0, -1, 0), 0.8f,
-                                               0.9f, make_float3(3, 3, 3)),
-                               make_spot_light(make_float3(-2, 1, 1), make_float3(0, 1, 0), 0.8f,
-                                               0.9f, make_float3(1, 1, 1)),
-                               make_spot_light(make_float3(0, -1, 3), make_float3(1, 0, 0), 0.5f,
-                                               0.7f, make_float3(2, 1, 1)),
-                               make_spot_light(make_float3(4, 3, -2),
-                                               make_float3(-1, -1, 0) / std::sqrt(2.0f), 0.9f,
-                                               0.95f, make_float3(5, 4, 4))};
+  std::vector<Light> lights = four_spot_lights();
   LightTree ablation = build_light_tree(lights), full = build_light_tree(lights);
   ablation.set_orientation_term(false);
   ASSERT_EQ(ablation.num_nodes(), 1);

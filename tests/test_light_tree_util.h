@@ -242,4 +242,17 @@ inline PickFit pick_fit(const std::vector<double>& counts, const std::vector<dou
   return f;
 }
 
+// Four spot lights with different positions, axes, cones and energies (bounding radius 0): a
+// light tree of one node, one light per lane (the orientation ablation tests).
+inline std::vector<Light> four_spot_lights() {
+  return {make_spot_light(make_float3(1, 2, 0), make_float3(0, -1, 0), 0.8f, 0.9f,
+                          make_float3(3, 3, 3)),
+          make_spot_light(make_float3(-2, 1, 1), make_float3(0, 1, 0), 0.8f, 0.9f,
+                          make_float3(1, 1, 1)),
+          make_spot_light(make_float3(0, -1, 3), make_float3(1, 0, 0), 0.5f, 0.7f,
+                          make_float3(2, 1, 1)),
+          make_spot_light(make_float3(4, 3, -2), make_float3(-1, -1, 0) / std::sqrt(2.0f), 0.9f,
+                          0.95f, make_float3(5, 4, 4))};
+}
+
 } // namespace canopy::test

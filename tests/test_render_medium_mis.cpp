@@ -117,3 +117,40 @@ TEST(RenderMediumMis, LightSamplesPhaseRaysAndTheirMisAgree) {
   expect_agree(mis, light_only, "MIS against light samples alone");
   expect_agree(mis, phase_only, "MIS against BSDF and phase-function rays alone");
 }
+
+// Extreme but valid media render without a non-finite sample: coefficients from 1e-20 to 1e20,
+// channels six decades apart, g near +-1, a box far smaller than a light's distance and one near
+// the coordinate limit, lights of 1e-6 and 1e6 at the same place.
+TEST(RenderMediumMis, ExtremeMediaStayFinite) {
+  const char* media[] = {
+      R"({"sigma_a": 0, "sigma_s": 1e20})",
+      R"({"sigma_a": 1e-20, "sigma_s": 1e-20})",
+      R"({"sigma_a": 0, "sigma_s": [1e6, 0, 1e-6], "g": 0.99999})",
+      R"({"sigma_a": 0.1, "sigma_s": 0.5, "g": -0.999999,
+          "bounds": {"min": [-0.001, 0.9999, -0.001], "max": [0.001, 1.0001, 0.001]}})",
+      R"({"sigma_a": 0, "sigma_s": 0.3, "bounds": {"min": [-1e17, -1e17, -1e17], "max": [1e17, 1e17, 1e17]}})",
+      R"({"sigma_a": 5, "sigma_s": 0})"};
+  for (const char* m : media) {
+    std::string json = std::string(R"({
+      "camera": { "position": [0, 1, 4], "look_at": [0, 1, 0] },
+      "film": { "width": 8, "height": 6 },
+      "integrator": { "max_depth": 3 },
+      "shapes": [ { "type": "quad", "corner": [-4, 0, -4], "edge1": [0, 0, 8], "edge2": [8, 0, 0] } ],
+      "lights": [ { "type": "point", "position": [0, 1, 0], "intensity": 1e6 },
+                  { "type": "point", "position": [0, 1, 0], "intensity": 1e-6 },
+                  { "type": "spot", "position": [1, 2, 0], "direction": [0, -1, 0], "intensity": 3, "cone_angle": 20 },
+                  { "type": "quad", "corner": [-0.5, 2, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": 2 } ],
+      "medium": )") + m +
+                       "}";
+    Scene scene = load_scene_from_string(json, "extreme-medium.json", ".");
+    ClRuntime rt;
+    RendererOptions opt;
+    Renderer r(rt, scene, opt);
+    RenderSettings rs;
+    rs.spp = 16;
+    Film f = r.render(rs);
+    EXPECT_EQ(r.stats().nonfinite_samples, 0u) << m;
+    for (const double4& s : f.sum)
+      ASSERT_TRUE(std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.z)) << m;
+  }
+}

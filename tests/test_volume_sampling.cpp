@@ -8,6 +8,7 @@
 // 0.01 / kChi2Tests (Bonferroni over the file); estimators must match their reference within 5
 // standard errors computed from the sample variance.
 #include "support/double3.h"
+#include "support/gamma_q.h"
 #include "volume/equiangular.h"
 #include "volume/medium.h"
 #include "volume/phase.h"
@@ -91,36 +92,7 @@ double simpson_split(const std::function<double(double)>& f, double a, double b,
 }
 
 // ---------------------------------------------------------------- chi-square
-// Regularised upper incomplete gamma Q(a, x) (series below a + 1, Lentz's continued fraction
-// above).
-double gamma_q(double a, double x) {
-  if (x <= 0) return 1;
-  double gln = std::lgamma(a);
-  if (x < a + 1) {
-    double ap = a, sum = 1 / a, del = sum;
-    for (int n = 0; n < 100000; ++n) {
-      ap += 1;
-      del *= x / ap;
-      sum += del;
-      if (std::fabs(del) < std::fabs(sum) * 1e-15) break;
-    }
-    return std::max(0.0, 1 - sum * std::exp(-x + a * std::log(x) - gln));
-  }
-  double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    double an = -i * (i - a);
-    b += 2;
-    d = an * d + b;
-    if (std::fabs(d) < 1e-300) d = 1e-300;
-    c = b + an / c;
-    if (std::fabs(c) < 1e-300) c = 1e-300;
-    d = 1 / d;
-    double del = d * c;
-    h *= del;
-    if (std::fabs(del - 1) < 1e-15) break;
-  }
-  return std::exp(-x + a * std::log(x) - gln) * h;
-}
+using canopy::test::gamma_q;
 
 // Pearson's chi-square of observed counts against expected probabilities (times n); categories
 // expected below 5 are pooled. Returns the p-value; `worst` names the largest contribution.

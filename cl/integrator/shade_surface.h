@@ -109,11 +109,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   // A direction into the geometric surface would leak light through it (shading normals).
   if (!(dot(wi, N) > 0.0f)) return out;
   beta = beta * bs.weight;
-  if (depth >= 2) {
-    float q = fmin(max3(beta), 0.95f);
-    if (u_rr >= q) return out;
-    beta = beta / q;
-  }
+  if (!russian_roulette(&beta, depth, u_rr)) return out;
   if (!(max3(beta) > 0.0f) || !(bs.is_delta || bs.pdf > 0.0f)) return out;
   pb->shade_P[path] = f4_from3(P, bs.is_delta ? 0.0f : bs.pdf);
   pb->ray_o[path] = f4_from3(P, 0.0f);

@@ -67,12 +67,7 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
     // Scatter at the free-flight point (Tr sigma_s / pdf <= 3 per channel: channel MIS).
     float3 x = a + d * t_free;
     beta = beta * medium_tr(&m, t_free) * sigma_s * (1.0f / medium_distance_pdf(&m, t_free));
-    int alive = max3(beta) > 0.0f;
-    if (alive && depth >= 2) { // Russian roulette, as at surfaces
-      float q = fmin(max3(beta), 0.95f);
-      alive = u_rr < q;
-      beta = beta / q;
-    }
+    int alive = max3(beta) > 0.0f && russian_roulette(&beta, depth, u_rr); // as at surfaces
     float pdf = 0.0f;
     float3 wi = phase_hg_sample(m.sigma_t.w, d, u1, u2, &pdf);
     Hit hs = h;

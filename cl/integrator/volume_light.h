@@ -75,13 +75,21 @@ INLINE float3 volume_transmittance(const SceneBuffers* sc, float3 o, float3 d, f
   return medium_transmittance(&m, o, d, tmax);
 }
 
+// A light sample whose MIS weight w is below VOLUME_ROULETTE_WEIGHT is traced with probability
+// w / VOLUME_ROULETTE_WEIGHT and then carries that weight (Russian roulette: unbiased). Near a
+// light the free-flight point's weight is tiny next to equiangular sampling's, and the roulette
+// saves most of those shadow rays, which would add little; the weight is dimensionless, so the
+// rule does not depend on the scene's units or brightness.
+#define VOLUME_ROULETTE_WEIGHT 0.1f
+
 // The shadow item of a light sampled from the segment's point at distance t, chosen with density
 // p_t by one technique in t (p_other: the other's density there): beta Tr(t) sigma_s p(theta) Li
 // Tr(leg) w / (p_t pmf pdf(wi)), w the power heuristic against the other technique and, when
-// `phase_mis`, against the phase-function technique. Returns 1 if an item was written.
+// `phase_mis`, against the phase-function technique (then the roulette above, with u_rr).
+// Returns 1 if an item was written.
 INLINE int volume_light_item(const Medium* m, const LightSamplerCtx* ls, int path, float3 a,
                              float3 d, float t, float p_t, float p_other, int phase_mis,
-                             float3 beta, int light, float pmf, float u1, float u2,
+                             float3 beta, int light, float pmf, float u1, float u2, float u_rr,
                              GLOBAL ShadowItem* out) {
   float3 x = a + d * t;
   LightSample s = sample_light(&ls->lights[light], x, u1, u2);
@@ -97,8 +105,12 @@ INLINE int volume_light_item(const Medium* m, const LightSamplerCtx* ls, int pat
   // point or spot light.
   float p_phase =
       phase_mis && !s.is_delta ? medium_distance_pdf(m, t) * (phase / (pmf * s.pdf)) : 0.0f;
-  float weight = power_heuristic3(p_t, p_other, p_phase) / p_t;
-  float3 c = beta * tr * xyz_of(m->sigma_s) * s.Li * (phase * weight / (pmf * s.pdf));
+  float w = power_heuristic3(p_t, p_other, p_phase);
+  if (w < VOLUME_ROULETTE_WEIGHT) {
+    if (u_rr * VOLUME_ROULETTE_WEIGHT >= w) return 0;
+    w = VOLUME_ROULETTE_WEIGHT;
+  }
+  float3 c = beta * tr * xyz_of(m->sigma_s) * s.Li * (phase * (w / p_t) / (pmf * s.pdf));
   // Non-finite contributions are kept (accumulate counts them), zero ones dropped.
   if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) return 0;
   ShadowItem item;
@@ -115,6 +127,7 @@ INLINE int volume_shadow_items(const LightSamplerCtx* ls, const SceneBuffers* sc
                                GLOBAL ShadowItem* out) {
   float u0 = lt_rng_next(rng), u1 = lt_rng_next(rng), u2 = lt_rng_next(rng);
   float u3 = lt_rng_next(rng), u4 = lt_rng_next(rng);
+  float u5 = lt_rng_next(rng), u6 = lt_rng_next(rng);
   if (!(pmf > 0.0f)) return 0;
   Medium m = sc->medium[0];
   float4 so = pb->seg_o[path];
@@ -130,14 +143,14 @@ INLINE int volume_shadow_items(const LightSamplerCtx* ls, const SceneBuffers* sc
   float t_eq = equiangular_sample(a, d, len, c, u0, &p_eq);
   if (p_eq > 0.0f)
     n += volume_light_item(&m, ls, path, a, d, t_eq, p_eq, medium_distance_pdf(&m, t_eq), phase_mis,
-                           beta, light, pmf, u1, u2, out + n);
+                           beta, light, pmf, u1, u2, u5, out + n);
   // The free-flight point, if it falls on the segment.
   if (t_free < len) {
     float p_ff = medium_distance_pdf(&m, t_free);
     if (p_ff > 0.0f)
       n +=
           volume_light_item(&m, ls, path, a, d, t_free, p_ff, equiangular_pdf(a, d, len, c, t_free),
-                            phase_mis, beta, light, pmf, u3, u4, out + n);
+                            phase_mis, beta, light, pmf, u3, u4, u6, out + n);
   }
   return n;
 }

@@ -101,6 +101,30 @@ LT_HOT LtView lt_view_v(const LtLanes* l, float3 P) {
   return v;
 }
 
+// The importance of four lanes from their falloff denominators `den` (d^2 for a point, d_min for
+// a segment), orientation factors `orient` (including the receiver's cosine) and half-space tests
+// `front`: E * orient / den, normalised by the largest energy and the smallest denominator among
+// the lanes (only ratios matter), at least LT_IMPORTANCE_FLOOR for a lane that can contribute.
+// If no lane can contribute but some has energy (bounds of the parent were looser than those of
+// its children) and `fallback` is set, lanes with energy are ranked by E / den alone, so a descent
+// never dead-ends and the pmf sums to 1 over the lights with energy; such picks contribute 0,
+// which keeps them unbiased.
+LT_HOT v4f lt_rank_v(const LtLanes* l, v4f den, v4f orient, v4m front, int fallback) {
+  v4f zero = v4_splat(0.0f);
+  v4m alive = v4_gt(l->energy, zero);
+  float emax = v4_hmax(l->energy);
+  float dmin = v4_hmin(v4_sel(v4_splat(3.0e38f), den, alive));
+  float inv_emax = emax > 0.0f ? 1.0f / emax : 0.0f;
+  v4f e = v4_mul(l->energy, v4_splat(inv_emax));
+  v4f g = v4_div(v4_splat(dmin), den);
+  v4f imp = v4_mul(v4_mul(e, g), orient);
+  v4m contributes = v4_and(v4_and(alive, v4_gt(orient, zero)), front);
+  v4f res = v4_sel(zero, v4_max(imp, v4_splat(LT_IMPORTANCE_FLOOR)), contributes);
+  if (fallback && !(v4_sum(res) > 0.0f) && emax > 0.0f)
+    res = v4_sel(zero, v4_max(v4_mul(e, g), v4_splat(LT_IMPORTANCE_FLOOR)), alive);
+  return res;
+}
+
 // Importance of four clusters for a shading point P with unit normal N (N = 0: no orientation,
 // e.g. a point in a medium or a two-sided/transmissive surface). Per lane:
 //   E * cos(theta') * max(cos(theta_i'), 0) / max(d^2, (r/2)^2)
@@ -127,22 +151,7 @@ LT_HOT v4f lt_importance_v(const LtLanes* l, float3 P, float3 N, int fallback) {
     cos_i = v4_sel(v4_add(v4_mul(ci, v.cos_u), v4_mul(si, v.sin_u)), one, v4_ge(ci, v.cos_u));
     cos_i = v4_max(cos_i, zero);
   }
-  v4m alive = v4_gt(l->energy, zero);
-  float emax = v4_hmax(l->energy);
-  float dmin2 = v4_hmin(v4_sel(v4_splat(3.0e38f), d2c, alive));
-  float inv_emax = emax > 0.0f ? 1.0f / emax : 0.0f;
-  v4f e = v4_mul(l->energy, v4_splat(inv_emax));
-  v4f g = v4_div(v4_splat(dmin2), d2c);
-  v4f oc = v4_mul(v.orient, cos_i);
-  v4f imp = v4_mul(v4_mul(e, g), oc);
-  v4m contributes = v4_and(v4_and(alive, v4_gt(oc, zero)), v.front);
-  v4f res = v4_sel(zero, v4_max(imp, v4_splat(LT_IMPORTANCE_FLOOR)), contributes);
-  // No lane can contribute but some has energy (bounds of the parent were looser than those of
-  // its children): rank by energy and distance alone, so a descent never dead-ends and the pmf
-  // sums to 1 over the lights with energy. Such picks contribute 0, which keeps them unbiased.
-  if (fallback && !(v4_sum(res) > 0.0f) && emax > 0.0f)
-    res = v4_sel(zero, v4_max(v4_mul(e, g), v4_splat(LT_IMPORTANCE_FLOOR)), alive);
-  return res;
+  return lt_rank_v(l, d2c, v4_mul(v.orient, cos_i), v.front, fallback);
 }
 // ---------------------------------------------------------------- segment importance (§5.2, Eq. 7)
 // Importance of four clusters for the ray segment x(t) = a + t d, t in [0, len] (a = q->P, unit
@@ -241,18 +250,7 @@ LT_HOT v4f lt_importance_seg_v(const LtLanes* l, const LtQuery* q, int fallback)
   // falloff 1/d_min, d_min clamped at r/2 like Eq. 3's d; normalised by the largest energy and
   // the smallest d_min among the lanes
   v4f dc = v4_max(v4_max(dist, v4_mul(l->r, v4_splat(0.5f))), v4_splat(1e-18f));
-  v4m alive = v4_gt(l->energy, zero);
-  float emax = v4_hmax(l->energy);
-  float dmin = v4_hmin(v4_sel(v4_splat(3.0e38f), dc, alive));
-  float inv_emax = emax > 0.0f ? 1.0f / emax : 0.0f;
-  v4f e = v4_mul(l->energy, v4_splat(inv_emax));
-  v4f g = v4_div(v4_splat(dmin), dc);
-  v4f imp = v4_mul(v4_mul(e, g), orient);
-  v4m contributes = v4_and(v4_and(alive, v4_gt(orient, zero)), front);
-  v4f res = v4_sel(zero, v4_max(imp, v4_splat(LT_IMPORTANCE_FLOOR)), contributes);
-  if (fallback && !(v4_sum(res) > 0.0f) && emax > 0.0f)
-    res = v4_sel(zero, v4_max(v4_mul(e, g), v4_splat(LT_IMPORTANCE_FLOOR)), alive);
-  return res;
+  return lt_rank_v(l, dc, orient, front, fallback);
 }
 
 // Importance of four lanes for a query: a point (lt_importance_v; N as the caller passes it, which

@@ -181,6 +181,7 @@ Film Renderer::render(const RenderSettings& settings) {
                 {"film_sumsq", uint64_t(npix) * sizeof(double4)},
                 {"film_counts", uint64_t(npix) * sizeof(double2)},
                 {"shadow_stage", shadow_slots * uint64_t(split_cap) * sizeof(ShadowItem)},
+                {"shadow_items", (medium ? 2 : 1) * uint64_t(split_cap) * sizeof(ShadowItem)},
                 {"child_stage", 4 * uint64_t(split_cap) * sizeof(SplitItem)},
                 {"brdf_stage", uint64_t(brdf_stages_ ? W : 1) * BRDF_MAX_BATCH * sizeof(BrdfItem)}},
                {{"film (host copy)", uint64_t(npix) * (2 * sizeof(double4) + sizeof(double2))},
@@ -215,7 +216,9 @@ Film Renderer::render(const RenderSettings& settings) {
   cl::Buffer split_b = device_buffer(ctx, split_cap * sizeof(SplitItem));
   buffer("child_stage", 4 * split_cap * sizeof(SplitItem));
   buffer("shadow_stage", shadow_slots * split_cap * sizeof(ShadowItem));
-  buffer("shadow_items", split_cap * sizeof(ShadowItem));
+  // A pass's shadow queue: one item per light in the cuts (at most split_cap of them), two for a
+  // medium segment's (equiangular and free-flight points).
+  buffer("shadow_items", (medium ? 2 : 1) * split_cap * sizeof(ShadowItem));
   cl::Buffer counts_pick = buffer("counts_pick", split_cap * sizeof(cl_int2));
   // BRDF-oriented sampling (brdf_mis.cl): each path's cut, one round's staged and compacted items.
   const size_t brdf_paths = brdf_stages_ ? W : 1;
