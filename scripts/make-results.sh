@@ -24,11 +24,13 @@
 #
 # Environment: SCENES, BUILD, CANOPY, SKIP_BUILD; BUDGET and REF_SPP override every scene's budget
 # and reference spp; SEEDS (3); WORK (out/results), DOCS (docs/results) and REPORT
-# (docs/results.md) move the outputs; SAMPLERS_MANY, SAMPLERS_GLOSSY and SAMPLERS_DIFFUSE replace
-# the sampler sets (SAMPLERS_FOG: the media scenes of issue 13); REUSE_REFERENCE=1 keeps a reference already in $WORK (same scene, film scale
-# and reference sampler: the caller's responsibility) instead of rendering it again. Scalability:
+# (docs/results.md) move the outputs; SAMPLERS_MANY, SAMPLERS_GLOSSY, SAMPLERS_DIFFUSE and
+# SAMPLERS_FOG (the media scenes of issue 13) replace the sampler sets; REUSE_REFERENCE=1 keeps a
+# reference already in $WORK (same scene, film scale and reference sampler: the caller's
+# responsibility) instead of rendering it again. Scalability:
 # SCALE_COUNTS (light counts, "1000 10000 100000"), SCALE_SPP (8), SCALE_REPS (3), SCALE_FILM
-# (film scale, 0.5 = 128 x 128), SCALE_SAMPLERS ("brdf-mis,tree-split").
+# (film scale, 0.5 = 128 x 128), SCALE_SAMPLERS ("brdf-mis,tree-split"). FOG_STATS_SPP (4): spp of
+# the fog scenes' --stats renders (shadow rays per segment and per surface point).
 #
 # References and other large intermediates go to $WORK (not committed); $DOCS gets the CSVs and
 # the small PNGs.
@@ -54,6 +56,11 @@ mkdir -p "$WORK" "$DOCS"
 # adaptive allocation, delta 0.5), brdf-oriented alone, brdf-mis/equal (equal allocation, their
 # Fig. 8) and brdf-mis:D, the sweep of the cut's split threshold delta (their Table 2).
 # "diffuse": the default scene, where brdf-mis must cost nothing over tree-split.
+# "fog": spiral-fog and city-fog (issue 13; SAMPLERS_FOG below). spiral-fog clamps for the same
+# reason as cornell-1m (its emissive tube is in view, a few pixels wide); city-fog's lights are
+# points (unseen). Their references are tree-split (the renderer's default); city-fog's film is
+# quartered (its tree-split costs about 10 s per spp at full size with ~46 shadow rays per ray
+# segment).
 SAMPLERS_MANY=${SAMPLERS_MANY:-uniform,power,tree,tree-noorient,tree-split:0.0,tree-split:0.25,tree-split:0.5,tree-split:0.85,tree-split:0.95}
 SAMPLERS_GLOSSY=${SAMPLERS_GLOSSY:-tree-split,tree-split/nomis,power,power/nomis,bsdf,brdf-mis,brdf-oriented,brdf-mis/equal,brdf-mis:0.005,brdf-mis:0.05,brdf-mis:0.1,brdf-mis:0.3,brdf-mis:0.7}
 SAMPLERS_DIFFUSE=${SAMPLERS_DIFFUSE:-tree-split,brdf-mis}
@@ -61,12 +68,14 @@ SAMPLERS_DIFFUSE=${SAMPLERS_DIFFUSE:-tree-split,brdf-mis}
 # sampling, the tree with and without splitting, each with the segment importance of ray
 # segments (Eq. 7, the default) and with the surface importance at the segment's midpoint
 # (/midpoint, the ablation).
-SAMPLERS_FOG=${SAMPLERS_FOG:-power,tree,tree/midpoint,tree-split,tree-split/midpoint}
+# tree-split runs at the scene's threshold (0.85, as city.json) and at the default (0.25).
+SAMPLERS_FOG=${SAMPLERS_FOG:-power,tree,tree/midpoint,tree-split,tree-split/midpoint,tree-split:0.25,tree-split:0.25/midpoint}
 SCALE_COUNTS=${SCALE_COUNTS:-"1000 10000 100000"}
 SCALE_SPP=${SCALE_SPP:-8}
 SCALE_REPS=${SCALE_REPS:-3}
 SCALE_FILM=${SCALE_FILM:-0.5}
 SCALE_SAMPLERS=${SCALE_SAMPLERS:-brdf-mis,tree-split}
+FOG_STATS_SPP=${FOG_STATS_SPP:-4}
 SEEDS=${SEEDS:-3}
 # Clamping (--clamp) biases heavy-tailed estimators (uniform sampling of the spiral, whose error
 # would then grow with spp), so only cornell-1m clamps: its 10^6 sub-pixel ceiling lights are in
@@ -93,8 +102,8 @@ plane-10k      | 1    | 20 | tree       | 1024 | 0 | many
 glossy-cornell | 0.5  | 20 | power      | 2048 | 1 | glossy
 showroom       | 0.5  | 20 | tree-split | 1024 | 0 | glossy
 default        | 0.5  | 20 | tree-split | 1024 | 1 | diffuse
-spiral-fog     | 0.5  | 20 | tree-split | 512  | 1 | fog
-city-fog       | 0.5  | 20 | tree-split | 512  | 0 | fog
+spiral-fog     | 0.5  | 20 | tree-split | 256  | 1 | fog
+city-fog       | 0.25 | 20 | tree-split | 256  | 0 | fog
 "
 SCENES=${SCENES:-"spiral-10k cornell-1m city mesh-light plane-10k glossy-cornell showroom default scalability spiral-fog city-fog"}
 
@@ -155,6 +164,16 @@ for name in $SCENES; do
   fi
   echo "== $name: reference $ref_sampler x $ref_spp spp, film scale $scale, budget $budget s," \
     "samplers $samplers" >&2
+  # The fog scenes' report quotes its exact command lines ($DOCS/$name-commands.txt).
+  if [ "$set" = fog ]; then
+    echo "canopy converge $scene --film-scale $scale ${clamp_opt[*]} --reference" \
+      "$WORK/$name-ref.exr ${ref_opt[*]} --samplers $samplers --budget $budget --seeds $SEEDS" \
+      "--out $DOCS/$name" | tr -s ' ' >"$DOCS/$name-commands.txt"
+    if [ ${#ref_opt[@]} = 0 ]; then
+      echo "# (REUSE_REFERENCE: $WORK/$name-ref.exr is from an earlier run of this script, made" \
+        "with --reference-sampler $ref_sampler --reference-spp $ref_spp)" >>"$DOCS/$name-commands.txt"
+    fi
+  fi
   "$CANOPY" converge "$scene" --film-scale "$scale" "${clamp_opt[@]}" \
     --reference "$WORK/$name-ref.exr" "${ref_opt[@]}" --samplers "$samplers" \
     --budget "$budget" --seeds "$SEEDS" --out "$DOCS/$name" | tee "$WORK/$name-converge.txt"
@@ -169,11 +188,21 @@ for name in $SCENES; do
   fi
   # Media: shadow rays per ray segment and per surface point (the paper's Fig. 1: "7 shadow rays
   # per shading point, 45 for the volume integral"), tree-split with either segment ranking, at
-  # the scene's film and spp.
+  # the scene's film and FOG_STATS_SPP spp (averages over 10^5-10^6 segments: more spp would not
+  # change them).
+  # Both segment rankings at the scene's threshold, and the segment importance at the default
+  # threshold (0.25; stats-segment-0.25.json).
   if [ "$set" = fog ]; then
-    for vi in segment midpoint; do
-      "$CANOPY" render "$scene" --light-sampler tree-split --volume-importance "$vi" \
-        --out "$WORK/$name-stats-$vi.exr" --stats-json "$DOCS/$name-stats-$vi.json" >/dev/null
+    for run in segment midpoint segment:0.25; do
+      vi=${run%%:*}
+      thr_opt=() tag=$vi
+      if [ "$run" != "$vi" ]; then thr_opt=(--split-threshold "${run#*:}") tag=$vi-${run#*:}; fi
+      "$CANOPY" render "$scene" --spp "$FOG_STATS_SPP" --light-sampler tree-split "${thr_opt[@]}" \
+        --volume-importance "$vi" --out "$WORK/$name-stats-$tag.exr" \
+        --stats-json "$DOCS/$name-stats-$tag.json" >/dev/null
+      echo "canopy render $scene --spp $FOG_STATS_SPP --light-sampler tree-split ${thr_opt[*]}" \
+        "--volume-importance $vi --out $WORK/$name-stats-$tag.exr --stats-json" \
+        "$DOCS/$name-stats-$tag.json" | tr -s ' ' >>"$DOCS/$name-commands.txt"
     done
   fi
   echo "== $name done, $(( $(date +%s) - start )) s so far" >&2
