@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parent.parent
 FILM = 8
 # Seeds whose load alone takes seconds (10^6 lights, 3*10^5 lights + a 300 KB OBJ): only in the
 # long form (--no-heavy leaves them out).
-HEAVY_SEEDS = {"cornell-1m.json", "city.json"}
+HEAVY_SEEDS = {"cornell-1m.json", "city.json", "city-fog.json"}
 # A mutant whose legal workload is large (many lights, a big film) says nothing about robustness
 # and would only time out: it is redrawn. Illegal values (above the format's limits) are kept.
 MAX_LIGHTS = 2_000_000

@@ -24,6 +24,7 @@
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
+#include "support/double3.h"
 
 #include <gtest/gtest.h>
 
@@ -42,23 +43,12 @@ using namespace canopy;
 namespace {
 
 // ---------------------------------------------------------------- double vectors
-struct V3 {
-  double x, y, z;
-};
-V3 operator+(V3 a, V3 b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-V3 operator-(V3 a, V3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-V3 operator*(V3 a, double s) {
-  return {a.x * s, a.y * s, a.z * s};
-}
+using V3 = D3; // support/double3.h
 double dot(V3 a, V3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
+  return ddot(a, b);
 }
 double len(V3 a) {
-  return std::sqrt(dot(a, a));
+  return dlen(a);
 }
 double comp(V3 a, int k) {
   return k == 0 ? a.x : k == 1 ? a.y : a.z;
