@@ -266,6 +266,8 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       args.set("max_depth", cl_int(3));
       cl::Buffer b_vc = to_device(rt_, std::vector<int>(2, 0));
       args.set("volume_counters", b_vc);
+      cl::Buffer b_pcv = to_device(rt_, std::vector<int4>(kPaths, make_int4(0, 0, 0, 0)));
+      args.set("path_counts", b_pcv);
       BoundKernel kv(program_, "shade_volume", args);
       enqueue_1d(rt_.queue(),
                  kv.bind({{"depth", depth}, {"queue", to_device(rt_, queue)}, {"count", kPaths}}),
@@ -273,8 +275,14 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
       Paths dev = download(args);
       PathBuffers pbv = paths.host();
       int segments = 0;
-      for (int i = 0; i < kPaths; ++i)
-        segments += shade_volume_item(queue[size_t(i)], depth, 3, &sc, &pbv, &ls);
+      std::vector<int4> dpcv = from_device<int4>(rt_, b_pcv, kPaths);
+      for (int i = 0; i < kPaths; ++i) {
+        int path = queue[size_t(i)];
+        // the emitter AOV is read from the hit before shade_volume replaces it
+        ASSERT_EQ(dpcv[size_t(path)].z, camera_ray_hits_emitter(depth, pbv.hits[path], &sc))
+            << "path " << path;
+        segments += shade_volume_item(path, depth, 3, &sc, &pbv, &ls);
+      }
       EXPECT_EQ(from_device<int>(rt_, b_vc, 1)[0], segments);
       compare_paths(dev, paths, queue);
       for (int path : queue) {
@@ -302,16 +310,28 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     args.set("brdf_cut", to_device(rt_, host_cut_));
     cl::Buffer b_counts(rt_.context(), CL_MEM_READ_WRITE, kPaths * sizeof(int2));
     args.set("counts_shade", b_counts);
+    cl::Buffer b_path_counts = to_device(rt_, std::vector<int4>(kPaths, make_int4(0, 0, 0, 0)));
+    args.set("path_counts", b_path_counts);
     args.set("max_depth", cl_int(3));
     BoundKernel k(program_, "shade_surface", args);
     enqueue_1d(rt_.queue(),
                k.bind({{"depth", depth}, {"queue", to_device(rt_, queue)}, {"count", kPaths}}),
                kPaths);
     std::vector<int2> dev_counts = from_device<int2>(rt_, b_counts, kPaths);
+    std::vector<int4> dev_pc = from_device<int4>(rt_, b_path_counts, kPaths);
     Paths dev = download(args);
     // ---- host reference on the same inputs
     Paths ref = paths;
     PathBuffers pb = ref.host();
+    int emitter_hits = 0;
+    for (int path : queue) {
+      int e = camera_ray_hits_emitter(depth, pb.hits[path], &sc);
+      ASSERT_EQ(dev_pc[size_t(path)].z, e) << "path " << path;
+      emitter_hits += e;
+    }
+    if (depth == 0) {
+      EXPECT_GT(emitter_hits, 0);
+    }
     std::vector<int2> ref_counts(kPaths);
     for (int i = 0; i < kPaths; ++i) {
       ref_counts[size_t(i)] = shade_surface_item(queue[size_t(i)], depth, 3, &sc, &pb, &ls);
@@ -577,13 +597,13 @@ void KernelStages::check_brdf_rounds(KernelArgs& args, const LightSamplerCtx& ls
     if (HasFailure()) return;
     // ---- brdf_accumulate of the host's traced items
     args.set("brdf_items", to_device(rt_, compact));
-    std::vector<int2> pc(kPaths, make_int2(0, 0));
+    std::vector<int4> pc(kPaths, make_int4(0, 0, 0, 0));
     cl::Buffer b_pc = to_device(rt_, pc);
     args.set("path_counts", b_pc);
     BoundKernel ka(program_, "brdf_accumulate", args);
     enqueue_1d(rt_.queue(), ka.bind({{"count", total}}), size_t(total));
     Paths dev = download(args);
-    std::vector<int2> dpc = from_device<int2>(rt_, b_pc, kPaths);
+    std::vector<int4> dpc = from_device<int4>(rt_, b_pc, kPaths);
     for (int i = 0; i < total; ++i) {
       int n = brdf_accumulate_item(i, compact.data(), total, &pb);
       if (n > 0) pc[float_as_uint_(compact[size_t(i)].dir.w)].x += n;
@@ -653,7 +673,7 @@ TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
     args.set(name, cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(float4)));
   args.set("rng", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(uint32_t)));
   args.set("ray_queue", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int)));
-  args.set("path_counts", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int2)));
+  args.set("path_counts", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int4)));
   BoundKernel k(program_, "generate", args);
   enqueue_1d(rt_.queue(), k.bind(), n);
   auto o = from_device<float4>(rt_, args.buffer("ray_o"), n);
@@ -694,16 +714,16 @@ void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(0, 10);
   std::vector<float4> radiance(wave);
-  std::vector<int2> counts(wave);
+  std::vector<int4> counts(wave);
   for (int i = 0; i < wave; ++i) {
     radiance[size_t(i)] = make_float4(u(rng), u(rng), u(rng), 0);
-    counts[size_t(i)] = make_int2(i % 5, 1);
+    counts[size_t(i)] = make_int4(i % 5, 1, i % 3 == 0, 0);
   }
   radiance[7].y = std::numeric_limits<float>::quiet_NaN();
   radiance[size_t(wave) / 2].z = std::numeric_limits<float>::infinity();
   std::vector<double4> sum(size_t(npix), double4{1, 1, 1, 2}),
       sumsq(size_t(npix), double4{0.5, 0.5, 0.5, 0});
-  std::vector<double2> fc(size_t(npix), double2{0, 0});
+  std::vector<double4> fc(size_t(npix), double4{0, 0, 0, 0});
   std::vector<int> nonfinite = {0};
   cl::Buffer b_r = to_device(rt_, radiance), b_s = to_device(rt_, sum), b_q = to_device(rt_, sumsq),
              b_n = to_device(rt_, nonfinite), b_c = to_device(rt_, counts),
@@ -721,7 +741,7 @@ void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
   BoundKernel k(program_, "accumulate", args);
   enqueue_1d(rt_.queue(), k.bind(), size_t(std::min(npix, wave)));
   auto dsum = from_device<double4>(rt_, b_s, npix), dsq = from_device<double4>(rt_, b_q, npix);
-  auto dfc = from_device<double2>(rt_, b_fc, npix);
+  auto dfc = from_device<double4>(rt_, b_fc, npix);
   EXPECT_EQ(from_device<int>(rt_, b_n, 1)[0], 2);
   // Reference: visit paths in order, add into their pixel (g mod npix).
   for (int i = 0; i < wave; ++i) {
@@ -735,6 +755,7 @@ void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
     sumsq[p] = double4{sumsq[p].x + x * x, sumsq[p].y + y * y, sumsq[p].z + z * z, 0};
     fc[p].x += double(counts[size_t(i)].x);
     fc[p].y += double(counts[size_t(i)].y);
+    fc[p].z += double(counts[size_t(i)].z);
   }
   for (int p = 0; p < npix; ++p) {
     EXPECT_EQ(dsum[size_t(p)].x, sum[size_t(p)].x) << p; // same order of additions: bit-identical
@@ -744,6 +765,7 @@ void KernelUtilities::check_accumulate(int npix, int wave, uint64_t base) {
     EXPECT_EQ(dsq[size_t(p)].y, sumsq[size_t(p)].y) << p;
     EXPECT_EQ(dfc[size_t(p)].x, fc[size_t(p)].x) << p;
     EXPECT_EQ(dfc[size_t(p)].y, fc[size_t(p)].y) << p;
+    EXPECT_EQ(dfc[size_t(p)].z, fc[size_t(p)].z) << p;
   }
 }
 
@@ -813,14 +835,14 @@ TEST_F(KernelUtilities, ScanScatterAndShadowSumsMatchTheHost) {
   // accumulate_shadow: each path's run of items is summed in order into its radiance.
   const int paths = n / 3 + 1;
   std::vector<float4> radiance(size_t(paths), make_float4(0.5f, 0, 0, 0));
-  std::vector<int2> pc(size_t(paths), make_int2(0, 0));
+  std::vector<int4> pc(size_t(paths), make_int4(0, 0, 0, 0));
   cl::Buffer b_rad = to_device(rt_, radiance), b_pc = to_device(rt_, pc);
   args.set("radiance", b_rad);
   args.set("path_counts", b_pc);
   BoundKernel ka(program_, "accumulate_shadow", args);
   enqueue_1d(rt_.queue(), ka.bind({{"count", int(sh.size())}}), sh.size());
   auto drad = from_device<float4>(rt_, b_rad, size_t(paths));
-  auto dpc = from_device<int2>(rt_, b_pc, size_t(paths));
+  auto dpc = from_device<int4>(rt_, b_pc, size_t(paths));
   std::vector<float> run_sum(size_t(paths), 0.0f);
   std::vector<int> run_count(size_t(paths), 0);
   for (const ShadowItem& s : ref_shadow) {

@@ -74,4 +74,11 @@ typedef struct SceneBuffers {
   SCENE_BUFFERS(CANOPY_SCENE_FIELD)
 } SceneBuffers;
 
+// Whether the camera ray of a path (depth 0) hits an emitter: the pixels whose error is measured
+// apart (`canopy converge`), since their noise is the anti-aliasing of the emitter's edge, not
+// light sampling. Read before shade_volume can replace the hit by a scattering event.
+INLINE int camera_ray_hits_emitter(int depth, Hit h, const SceneBuffers* sc) {
+  return depth == 0 && h.prim >= 0 && sc->prims[h.prim].light >= 0;
+}
+
 #endif // CANOPY_INTEGRATOR_PATH_STATE_H

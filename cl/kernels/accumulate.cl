@@ -4,7 +4,7 @@
 // holds several samples of the same pixel. film_sum.w counts samples; film_sumsq holds the
 // per-channel second moment for variance estimates. A non-finite sample never reaches the film:
 // it is counted in nonfinite[0] and recorded as zero. film_counts gathers each pixel's shadow rays
-// and shading points (the heat map of Fig. 18).
+// and shading points (the heat map of Fig. 18) and its samples whose camera ray hit an emitter.
 //
 // The film is summed in double (cl_khr_fp64, checked by the host before the build): a float sum
 // stops growing once it is 2^24 times a sample (at 2^22 spp a pixel came out 3-5% low) and
@@ -16,14 +16,14 @@
 
 __kernel void accumulate(ulong wave_base, int wave_size, int npix, __global const float4* radiance,
                          __global double4* film_sum, __global double4* film_sumsq,
-                         __global int* nonfinite, __global const int2* path_counts,
-                         __global double2* film_counts) {
+                         __global int* nonfinite, __global const int4* path_counts,
+                         __global double4* film_counts) {
   int first = get_global_id(0);
   if (first >= min(wave_size, npix)) return;
   int p = (int)((wave_base + (ulong)first) % (ulong)npix);
   double4 sum = film_sum[p];
   double4 sumsq = film_sumsq[p];
-  double2 counts = film_counts[p];
+  double4 counts = film_counts[p];
   for (int i = first; i < wave_size; i += npix) {
     float3 L = radiance[i].xyz;
     if (!(isfinite(L.x) && isfinite(L.y) && isfinite(L.z))) {
@@ -33,7 +33,7 @@ __kernel void accumulate(ulong wave_base, int wave_size, int npix, __global cons
     double3 Ld = convert_double3(L);
     sum += (double4)(Ld, 1.0);
     sumsq += (double4)(Ld * Ld, 0.0);
-    counts += convert_double2(path_counts[i]);
+    counts += convert_double4(path_counts[i]);
   }
   film_counts[p] = counts;
   film_sum[p] = sum;

@@ -60,7 +60,7 @@ __kernel void brdf_trace(PATH_PARAMS SCENE_PARAMS LIGHT_SAMPLER_PARAMS __global 
 }
 
 __kernel void brdf_accumulate(__global const BrdfItem* brdf_items, int count, PATH_PARAMS
-                              __global int2* path_counts) {
+                              __global int4* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
   PATH_ASSEMBLE(pb);

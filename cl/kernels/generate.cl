@@ -8,7 +8,7 @@ __kernel void generate(__global const CameraParams* cam, uint seed, ulong wave_b
                        __global float4* ray_o, __global float4* ray_d,
                        __global float4* throughput, __global float4* radiance,
                        __global uint* rng, __global int* ray_queue,
-                       __global int2* path_counts) {
+                       __global int4* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
   ulong g = wave_base + (ulong)i;
@@ -27,5 +27,5 @@ __kernel void generate(__global const CameraParams* cam, uint seed, ulong wave_b
   radiance[i] = (float4)(0.0f);
   rng[i] = r.state;
   ray_queue[i] = i;
-  path_counts[i] = (int2)(0, 0); // shadow rays, shading points
+  path_counts[i] = (int4)(0); // shadow rays, shading points, camera ray hit an emitter
 }

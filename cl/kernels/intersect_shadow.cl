@@ -16,7 +16,7 @@ __kernel void intersect_shadow(__global const BvhNode* nodes, __global const int
 }
 
 __kernel void accumulate_shadow(__global const ShadowItem* shadow_items, int count,
-                                __global float4* radiance, __global int2* path_counts) {
+                                __global float4* radiance, __global int4* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
   int path = as_int(shadow_items[i].dir.w);

@@ -6,13 +6,15 @@
 
 __kernel void shade_surface(int depth, int max_depth, __global const int* queue, int count,
                             PATH_PARAMS SCENE_PARAMS LIGHT_SAMPLER_PARAMS
-                            __global int2* counts_shade) {
+                            __global int2* counts_shade, __global int4* path_counts) {
   int i = get_global_id(0);
   if (i >= count) return;
   PATH_ASSEMBLE(pb);
   SCENE_ASSEMBLE(sc);
   LIGHT_SAMPLER_ASSEMBLE(ls);
   int path = queue[i];
+  // (with a medium, shade_volume has also looked, before it could replace the hit)
+  if (camera_ray_hits_emitter(depth, pb.hits[path], &sc)) path_counts[path].z = 1;
   int2 c = shade_surface_item(path, depth, max_depth, &sc, &pb, &ls);
   if (HAS_MEDIUM) c = shade_counts_with_volume(c, path, &pb); // shade_volume ran first
   counts_shade[i] = c;
@@ -21,7 +23,7 @@ __kernel void shade_surface(int depth, int max_depth, __global const int* queue,
 __kernel void scatter_shade(__global const int* queue, int count, SCAN_PARAMS
                             __global int* queue_out, __global SplitItem* split_out,
                             float4 lt_root_sphere, float4 lt_root_info, uint max_cut,
-                            __global int2* path_counts, __global const float4* seg_o) {
+                            __global int4* path_counts, __global const float4* seg_o) {
   int i = get_global_id(0);
   if (i >= count) return;
   int2 c = counts[i];

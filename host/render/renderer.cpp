@@ -95,6 +95,13 @@ uint64_t Film::overflowed_pixels() const {
   return over;
 }
 
+std::vector<uint8_t> Film::emitter_mask() const {
+  std::vector<uint8_t> m(counts.size());
+  for (size_t p = 0; p < counts.size(); ++p)
+    m[p] = counts[p].z > 0.0 ? 1 : 0;
+  return m;
+}
+
 RgbImage Film::shadow_ray_heatmap(float max_rays) const {
   RgbImage img;
   img.width = width;
@@ -179,12 +186,12 @@ Film Renderer::render(const RenderSettings& settings) {
   check_memory(rt_.device(),
                {{"film_sum", uint64_t(npix) * sizeof(double4)},
                 {"film_sumsq", uint64_t(npix) * sizeof(double4)},
-                {"film_counts", uint64_t(npix) * sizeof(double2)},
+                {"film_counts", uint64_t(npix) * sizeof(double4)},
                 {"shadow_stage", shadow_slots * uint64_t(split_cap) * sizeof(ShadowItem)},
                 {"shadow_items", (medium ? 2 : 1) * uint64_t(split_cap) * sizeof(ShadowItem)},
                 {"child_stage", 4 * uint64_t(split_cap) * sizeof(SplitItem)},
                 {"brdf_stage", uint64_t(brdf_stages_ ? W : 1) * BRDF_MAX_BATCH * sizeof(BrdfItem)}},
-               {{"film (host copy)", uint64_t(npix) * (2 * sizeof(double4) + sizeof(double2))},
+               {{"film (host copy)", uint64_t(npix) * 3 * sizeof(double4)},
                 {"image", uint64_t(npix) * 3 * sizeof(float)}},
                printable(scene_.path.string(), 1024));
 
@@ -236,11 +243,11 @@ Film Renderer::render(const RenderSettings& settings) {
   cl::Buffer nonfinite = buffer("nonfinite", sizeof(cl_int));
   cl::Buffer film_sum = buffer("film_sum", size_t(npix) * sizeof(double4));
   cl::Buffer film_sumsq = buffer("film_sumsq", size_t(npix) * sizeof(double4));
-  cl::Buffer film_counts = buffer("film_counts", size_t(npix) * sizeof(double2));
-  buffer("path_counts", W * sizeof(cl_int2));
+  cl::Buffer film_counts = buffer("film_counts", size_t(npix) * sizeof(double4));
+  buffer("path_counts", W * sizeof(cl_int4));
   q.enqueueFillBuffer(film_sum, cl_double(0), 0, size_t(npix) * sizeof(double4));
   q.enqueueFillBuffer(film_sumsq, cl_double(0), 0, size_t(npix) * sizeof(double4));
-  q.enqueueFillBuffer(film_counts, cl_double(0), 0, size_t(npix) * sizeof(double2));
+  q.enqueueFillBuffer(film_counts, cl_double(0), 0, size_t(npix) * sizeof(double4));
   // The 32-bit device counters (non-finite samples, cut-size histogram) count one wave at a time
   // (at most W * max_depth events) and are added into the 64-bit stats after each wave: a whole
   // render at 2^24 spp has more than 2^31 samples.
@@ -404,7 +411,7 @@ Film Renderer::render(const RenderSettings& settings) {
   film.sum.resize(size_t(npix));
   film.sumsq.resize(size_t(npix));
   film.counts.resize(size_t(npix));
-  q.enqueueReadBuffer(film_counts, CL_TRUE, 0, size_t(npix) * sizeof(double2), film.counts.data());
+  q.enqueueReadBuffer(film_counts, CL_TRUE, 0, size_t(npix) * sizeof(double4), film.counts.data());
   q.enqueueReadBuffer(film_sum, CL_TRUE, 0, size_t(npix) * sizeof(double4), film.sum.data());
   q.enqueueReadBuffer(film_sumsq, CL_TRUE, 0, size_t(npix) * sizeof(double4), film.sumsq.data());
   // Undo the device's emission scale 2^-k: exact in double (a power of two; the sums of float

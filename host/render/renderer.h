@@ -71,7 +71,9 @@ static_assert(sizeof(Material) == 64 && sizeof(Light) == 96 && sizeof(Primitive)
 struct Film {
   int width = 0, height = 0;
   std::vector<double4> sum, sumsq;
-  std::vector<double2> counts; // per pixel: (shadow rays, shading points), summed over samples
+  // Per pixel, summed over samples: (shadow rays, shading points, samples whose camera ray hit an
+  // emitter, 0).
+  std::vector<double4> counts;
   // Per-pixel means as float32. A value beyond +-FLT_MAX is written as +-FLT_MAX, never Inf.
   RgbImage mean() const;
   // Pixels with a channel whose mean is beyond +-FLT_MAX (written clamped by mean()).
@@ -79,6 +81,9 @@ struct Film {
   // Shadow rays per shading point in each pixel, mapped through a false-colour ramp from 0 to
   // `max_rays` (0: the image's maximum) -- Conty Estevez & Kulla 2018, Fig. 18.
   RgbImage shadow_ray_heatmap(float max_rays = 0.0f) const;
+  // Per pixel: 1 if any camera ray of the pixel hit an emitter directly, else 0 (an AOV from the
+  // renderer, so error metrics can leave out the pixels whose noise is the emitters' own edges).
+  std::vector<uint8_t> emitter_mask() const;
 };
 
 struct RenderSettings {
