@@ -73,6 +73,7 @@ INLINE int brdf_material_glossy(const Material* m) {
 // The point's material, shading frame, wo (world and local) and cap lobe (cap_integral.h).
 typedef struct BrdfPoint {
   float3 P, N; // shading point (ray origin) and geometric normal facing wo
+  float3 Nq;   // the normal of its light-tree queries (light_query_normal: the shading normal)
   Material m;
   Frame fr;
   float3 wo, wo_local;
@@ -86,6 +87,7 @@ INLINE BrdfPoint brdf_point(const LightSamplerCtx* ls, const SceneBuffers* sc,
   BrdfPoint bp;
   bp.P = xyz_of(pb->shade_P[path]);
   bp.N = xyz_of(pb->shade_N[path]);
+  bp.Nq = light_query_normal(pb, path);
   float4 ns_m = pb->shade_Ns[path];
   bp.m = sc->materials[(int)float_as_uint_(ns_m.w)];
   bp.fr = frame_from(xyz_of(ns_m));
@@ -99,7 +101,7 @@ INLINE BrdfPoint brdf_point(const LightSamplerCtx* ls, const SceneBuffers* sc,
 
 // Probability that BRDF-oriented light sampling picks `light` at the point.
 INLINE float brdf_light_pmf(const LightSamplerCtx* ls, const BrdfPoint* bp, int light) {
-  return lt_brdf_pmf(&ls->tree, bp->cut, bp->state.x, bp->P, bp->N, &bp->lobe, light);
+  return lt_brdf_pmf(&ls->tree, bp->cut, bp->state.x, bp->P, bp->Nq, &bp->lobe, light);
 }
 
 // Weight of the tree light sample (density p_L) against N BRDF-aware samples drawn with share s
@@ -140,7 +142,7 @@ INLINE int2 brdf_cut_item(int path, const LightSamplerCtx* ls, const SceneBuffer
   if (pb->brdf_state[path].y != -1) return make_int2(0, 0);
   BrdfPoint bp = brdf_point(ls, sc, pb, path);
   float I_B;
-  int n = lt_brdf_cut_build(&ls->tree, bp.P, bp.N, &bp.lobe, ls->brdf_delta, bp.cut, &I_B);
+  int n = lt_brdf_cut_build(&ls->tree, bp.P, bp.Nq, &bp.lobe, ls->brdf_delta, bp.cut, &I_B);
   int N;
   if (ls->kind == SAMPLER_BRDF_ORIENTED)
     N = 1;
@@ -182,7 +184,7 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
     BrdfItem it;
     if (use_light) {
       float pmf;
-      int light = lt_brdf_pick(&ls->tree, bp.cut, bp.state.x, bp.P, bp.N, &bp.lobe, &rng, &pmf);
+      int light = lt_brdf_pick(&ls->tree, bp.cut, bp.state.x, bp.P, bp.Nq, &bp.lobe, &rng, &pmf);
       if (light < 0) continue;
       float u1 = lt_rng_next(&rng), u2 = lt_rng_next(&rng);
       LightPoint lp;
@@ -190,7 +192,7 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
       float p_B = pmf * lp.s.pdf;
       float p_L = 0.0f;
       if (ls->kind != SAMPLER_BRDF_ORIENTED)
-        p_L = lt_pmf_split(&ls->tree, bp.P, bp.N, light, ls->threshold, ls->max_cut) * lp.s.pdf;
+        p_L = lt_pmf_split(&ls->tree, bp.P, bp.Nq, light, ls->threshold, ls->max_cut) * lp.s.pdf;
       float q = p_i * p_B + (1.0f - p_i) * lp.bsdf_pdf;
       float w = 1.0f - brdf_weight_tree(ls, p_L, p_B, lp.bsdf_pdf, st.y, pb->brdf_share[path]);
       float3 c = beta * lp.f_cos * lp.s.Li * (w * inv_n / q);
@@ -258,7 +260,7 @@ INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls,
   float p_B = brdf_light_pmf(ls, &bp, light) * pdf_y;
   float p_L = 0.0f;
   if (ls->kind != SAMPLER_BRDF_ORIENTED)
-    p_L = lt_pmf_split(&ls->tree, bp.P, bp.N, light, ls->threshold, ls->max_cut) * pdf_y;
+    p_L = lt_pmf_split(&ls->tree, bp.P, bp.Nq, light, ls->threshold, ls->max_cut) * pdf_y;
   float p_S = it.extra.x, p_i = it.extra.y;
   float q = p_i * p_B + (1.0f - p_i) * p_S;
   float w = 1.0f - brdf_weight_tree(ls, p_L, p_B, p_S, bp.state.y, pb->brdf_share[path]);

@@ -74,7 +74,7 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
     q = volume_query(pb, path);
     seed = float_as_uint_(pb->seg_beta[path].w);
   } else {
-    q = lt_query_point(xyz_of(pb->shade_P[path]), xyz_of(pb->shade_N[path]));
+    q = lt_query_point(xyz_of(pb->shade_P[path]), light_query_normal(pb, path));
     seed = float_as_uint_(pb->shade_N[path].w);
   }
   const LtTree* t = &ls->tree;

@@ -74,6 +74,17 @@ typedef struct SceneBuffers {
   SCENE_BUFFERS(CANOPY_SCENE_FIELD)
 } SceneBuffers;
 
+// The normal a shading point's light-tree queries bound the receiver's cosine with (Conty Estevez
+// & Kulla 2018, Eq. 3's theta_i): the shading normal, the one whose cosine the BSDF applies
+// (light_point.h). With the geometric normal, lights near the geometric horizon of a smooth-shaded
+// mesh got a far smaller pmf than their contribution (fireflies at silhouettes). The bound stays
+// conservative: a direction below the shading horizon contributes nothing, and one below the
+// geometric surface is rejected besides (as pbrt-v4's LightSampleContext, which carries ns).
+// shade_surface, light_pick and the BRDF-oriented cut all read it here, so their pmfs agree.
+INLINE float3 light_query_normal(const PathBuffers* pb, int path) {
+  return xyz_of(pb->shade_Ns[path]);
+}
+
 // Whether the camera ray of a path (depth 0) hits an emitter: the pixels whose error is measured
 // apart (`canopy converge`), since their noise is the anti-aliasing of the emitter's edge, not
 // light sampling. Read before shade_volume can replace the hit by a scattering event.

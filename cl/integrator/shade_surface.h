@@ -6,6 +6,12 @@
 // - Records the shading point (position, normals, wo, material, throughput) for light_pick, which
 //   does next-event estimation in the split passes, and for MIS at the next hit.
 // - Samples the BSDF for the next bounce (Russian roulette from the third bounce on).
+// max_depth counts the vertices that sample lights, as in pbrt-v4: the last one (depth + 1 ==
+// max_depth) still traces its BSDF ray, whose hit (depth == max_depth) only adds the emission it
+// finds, MIS-weighted, and ends the path. So max_depth 1 is direct light with MIS, and a mirror
+// (which samples no light) reflects emitters at every depth. That ray is traced only where the
+// emission it can find has a weight: not from a glossy point of a BRDF sampler, whose direct
+// light is complete without it, nor after a non-delta bounce without MIS.
 // Returns (continues, shade): whether the path goes on, and whether light_pick must sample lights
 // for this shading point.
 #ifndef CANOPY_INTEGRATOR_SHADE_SURFACE_H
@@ -34,8 +40,7 @@ INLINE float shade_emission_weight(const LightSamplerCtx* ls, const SceneBuffers
   if (HAS_MICROFACET && light_sampler_brdf(ls) && pb->shade_f[path].w == BRDF_POINT_FLAG)
     return 0.0f;
   if (!CANOPY_MIS) return 0.0f; // light sampling alone accounts for it
-  float3 prev_N = xyz_of(pb->shade_N[path]);
-  float pmf = light_sampler_pmf(ls, xyz_of(prev_P), prev_N, light);
+  float pmf = light_sampler_pmf(ls, xyz_of(prev_P), light_query_normal(pb, path), light);
   float p_light = pmf * light_pdf(&ls->lights[light], xyz_of(prev_P), P);
   return power_heuristic(prev_P.w, p_light);
 }
@@ -72,6 +77,10 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
     float4 L = pb->radiance[path];
     pb->radiance[path] = f4_from3(xyz_of(L) + beta * Le * w, 0.0f);
   }
+  if (depth >= max_depth) { // the last vertex's BSDF ray: emission only, no material evaluation
+    if (HAS_MICROFACET && light_sampler_brdf(ls)) pb->brdf_state[path] = make_int4(0, 0, 0, 0);
+    return out;
+  }
 
   PathRng r;
   r.state = pb->rng[path];
@@ -83,11 +92,11 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   float u3 = rng_next_float(&r);
   pb->rng[path] = r.state;
 
-  int continues = depth + 1 < max_depth;
+  int last = depth + 1 >= max_depth; // the BSDF ray only looks for emission (see the top)
   // Light shapes are black diffuse: nothing to pick lights for.
   int black = m.type == MATERIAL_DIFFUSE && !(max3(xyz_of(m.albedo)) > 0.0f);
   out.y = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && bsdf_has_smooth_lobe(&m) && !black;
-  float mis_flag = continues && CANOPY_MIS ? 1.0f : 0.0f;
+  float mis_flag = CANOPY_MIS ? 1.0f : 0.0f;
   if (HAS_MICROFACET && light_sampler_brdf(ls)) {
     // Glossy points get BRDF-oriented sampling (brdf_mis.h: -1 asks brdf_cut for the cut);
     // brdf-oriented alone takes no tree light sample there.
@@ -101,10 +110,12 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   pb->shade_wo[path] = f4_from3(wo, 0.0f);
   pb->shade_Ns[path] = f4_from3(Ns, uint_as_float_((uint)prim->material));
   pb->shade_P[path] = f4_from3(P, 0.0f);
-  if (!continues) return out;
+  if (black) return out;
 
   Frame fr = frame_from(Ns);
   BsdfSample bs = bsdf_sample(&m, frame_to_local(&fr, wo), make_float3(u1, u2, u3));
+  // From the last vertex, only a ray whose emission gets a weight (shade_emission_weight).
+  if (last && !bs.is_delta && ls->kind != SAMPLER_BSDF && !(mis_flag == 1.0f)) return out;
   float3 wi = frame_to_world(&fr, bs.wi);
   // A direction into the geometric surface would leak light through it (shading normals).
   if (!(dot(wi, N) > 0.0f)) return out;

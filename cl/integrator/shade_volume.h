@@ -10,6 +10,9 @@
 //   the Henyey-Greenstein phase function; otherwise the path reaches its hit with weight
 //   Tr / P(reach). On a path's last vertex nothing continues: the hit is shaded with weight Tr, and
 //   the medium's share of that bounce is the segment's direct light alone.
+// - The ray after the last vertex (depth == max_depth: a surface's BSDF ray that looks only for
+//   emission, shade_surface.h) neither scatters nor samples lights: what is scattered along it
+//   is light of a longer path. Its hit's emission is weighted by Tr.
 // Returns 1 if the path's segment gets light samples.
 #ifndef CANOPY_INTEGRATOR_SHADE_VOLUME_H
 #define CANOPY_INTEGRATOR_SHADE_VOLUME_H
@@ -56,7 +59,7 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
   float u_rr = rng_next_float(&r);
   pb->rng[path] = r.state;
   float t_free = medium_sample_distance(&m, u_free);
-  int lights = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && len > 0.0f;
+  int lights = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && len > 0.0f && depth < max_depth;
   pb->seg_o[path] = f4_from3(a, lights ? len : -1.0f);
   pb->seg_d[path] = f4_from3(d, t_free);
   pb->seg_beta[path] = f4_from3(beta, uint_as_float_(seed));

@@ -310,7 +310,10 @@ Film Renderer::render(const RenderSettings& settings) {
     cl::Buffer* q_in = &queue_a;
     cl::Buffer* q_out = &queue_b;
     int count = count0;
-    for (int depth = 0; depth < max_depth && count > 0; ++depth) {
+    // max_depth vertices sample lights; the rays leaving the last of them (depth == max_depth) only
+    // look for emission (cl/integrator/shade_surface.h): no light picks or BRDF rounds for them.
+    for (int depth = 0; depth <= max_depth && count > 0; ++depth) {
+      const bool emission_only = depth == max_depth;
       run("intersect_closest", k_closest.bind({{"queue", *q_in}, {"count", count}}), size_t(count));
       if (medium)
         run("shade_volume", k_volume->bind({{"depth", depth}, {"queue", *q_in}, {"count", count}}),
@@ -330,7 +333,7 @@ Film Renderer::render(const RenderSettings& settings) {
       q.enqueueFillBuffer(cut_size, cl_int(0), 0, W * sizeof(cl_int));
       // The BRDF-oriented cuts first: tree light samples at glossy points are weighted with them.
       int brdf_rounds = 0; // enough for the bounce's largest N (brdf_mis.h)
-      if (brdf_stages_) {
+      if (brdf_stages_ && !emission_only) {
         q.enqueueFillBuffer(brdf_counters, cl_int(0), 3 * sizeof(cl_int), sizeof(cl_int));
         run("brdf_cut", k_brdf_cut->bind({{"queue", *q_in}, {"count", count}}), size_t(count));
         cl_int max_n = 0;
@@ -368,7 +371,8 @@ Film Renderer::render(const RenderSettings& settings) {
         run("brdf_accumulate", k_brdf_sum->bind({{"count", n_items}}), size_t(n_items));
         stats_.brdf_rays += uint64_t(n_items);
       }
-      run("cut_histogram", k_histogram.bind({{"queue", *q_in}, {"count", count}}), size_t(count));
+      if (!emission_only)
+        run("cut_histogram", k_histogram.bind({{"queue", *q_in}, {"count", count}}), size_t(count));
 
       std::swap(q_in, q_out);
       count = next_count;
