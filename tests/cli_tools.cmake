@@ -116,7 +116,7 @@ elseif(MODE STREQUAL "converge")
   endif()
 
   # Equal time at depth 1: a reference timed to ~2 s, 3 seeds of ~0.1 s per configuration (the
-  # 8-seed minimum is make-results.sh's), then the reference reused.
+  # 8-seed minimum is make-results.sh's), then the reference reused at another depth (refused).
   run_canopy(0 converge "${SCENE}" --reference "${DIR}/ref1.exr" --reference-time 2
              --reference-sampler tree-split:0.5 --samplers power,tree-split --equal-time 0.1
              --seeds 3 --max-depth 1 --out "${DIR}/eq")
