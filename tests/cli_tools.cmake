@@ -2,7 +2,8 @@
 # to register the tests; the same file, run with `cmake -DMODE=... -P cli_tools.cmake`, is the
 # test driver (so the registration and the checks stay together).
 #   MODE=compare   EXE, OIIOTOOL, DIR: two tiny EXRs made with oiiotool; output, exit codes
-#   MODE=converge  EXE, SCENE, DIR: a 2-second converge run writes the CSVs and both plots
+#   MODE=converge  EXE, SCENE, DIR: a 2-second converge run writes the CSVs and both plots; an
+#                  equal-time run (--equal-time, --max-depth 1) writes the statistics columns
 
 if(NOT CMAKE_SCRIPT_MODE_FILE)
   # ------------------------------------------------------------------ registration
@@ -94,11 +95,12 @@ elseif(MODE STREQUAL "converge")
   foreach(s ",power,power," ",tree,tree," ",tree-noorient,tree," ",tree-split:0.5,tree-split,0.5,")
     expect_contains("${rows}" "${s}")
   endforeach()
-  # The mis column (last): /nomis renders with MIS off, every other configuration with MIS on.
+  # The mis column (before max_depth, mode, timing_seconds): /nomis renders with MIS off, every
+  # other configuration with MIS on.
   file(STRINGS "${DIR}/tiny-configs.csv" cfg_rows)
-  foreach(re "^tiny_converge,tree-split:0.5/nomis,tree-split,0.5,.*,0$"
-             "^tiny_converge,tree-split:0.5,tree-split,0.5,.*,1$"
-             "^tiny_converge,power,power,.*,1$")
+  foreach(re "^tiny_converge,tree-split:0.5/nomis,tree-split,0.5,.*,0,1,curve,[0-9.]+$"
+             "^tiny_converge,tree-split:0.5,tree-split,0.5,.*,1,1,curve,[0-9.]+$"
+             "^tiny_converge,power,power,.*,1,1,curve,[0-9.]+$")
     set(hits ${cfg_rows})
     list(FILTER hits INCLUDE REGEX "${re}")
     list(LENGTH hits n)
@@ -108,6 +110,43 @@ elseif(MODE STREQUAL "converge")
   endforeach()
   expect_contains("${out}" "equal-time RMSE")
   expect_contains("${err}" "light_sampler tree-split") # the reference's metadata, read back
+  expect_contains("${header}" "max_depth,mode,mse,top_share,worst_pixel,mse_ne")
+  if(NOT EXISTS "${DIR}/ref.mask.png")
+    message(FATAL_ERROR "canopy converge did not write the emitter mask ${DIR}/ref.mask.png")
+  endif()
+
+  # Equal time at depth 1: a reference timed to ~2 s, 3 seeds of ~0.1 s per configuration (the
+  # 8-seed minimum is make-results.sh's), then the reference reused at another depth (refused).
+  run_canopy(0 converge "${SCENE}" --reference "${DIR}/ref1.exr" --reference-time 2
+             --reference-sampler tree-split:0.5 --samplers power,tree-split --equal-time 0.1
+             --seeds 3 --max-depth 1 --out "${DIR}/eq")
+  file(STRINGS "${DIR}/eq-points.csv" pts)
+  list(GET pts 0 pheader)
+  foreach(col "mode,spp,runs,seconds" "mse,mse_lo,mse_hi,efficiency,efficiency_lo,efficiency_hi"
+              "top_share_mean,top_share_max,worst_pixel_max,reference_floor,resolved"
+              "mse_ne,mse_lo_ne,mse_hi_ne,efficiency_ne" "reference_floor_ne,resolved_ne")
+    expect_contains("${pheader}" "${col}")
+  endforeach()
+  list(LENGTH pts n)
+  if(NOT n EQUAL 3)
+    message(FATAL_ERROR "eq-points.csv: expected a header and one row per configuration:\n${pts}")
+  endif()
+  foreach(re "^tiny_converge,power,power,[^,]*,1,1,equal-time,[1-9][0-9]*,3,"
+             "^tiny_converge,tree-split,tree-split,[^,]*,1,1,equal-time,[1-9][0-9]*,3,")
+    set(hits ${pts})
+    list(FILTER hits INCLUDE REGEX "${re}")
+    list(LENGTH hits nh)
+    if(NOT nh EQUAL 1)
+      message(FATAL_ERROR "eq-points.csv: expected one row matching ${re}:\n${pts}")
+    endif()
+  endforeach()
+  expect_contains("${out}" "equal time 0.1 s, max depth 1, 3 seeds")
+  expect_contains("${err}" "max_depth 1")
+  expect_contains("${err}" "reference_mse_nonemitter")
+  # A reference of another depth is invalid input.
+  run_canopy(2 converge "${SCENE}" --reference "${DIR}/ref1.exr" --max-depth 2 --equal-time 0.1
+             --seeds 1)
+  expect_contains("${err}" "rendered with max depth 1, the measurements use 2")
   # A reference of the wrong size is invalid input.
   run_canopy(2 converge "${SCENE}" --reference "${DIR}/ref.exr" --film-scale 0.5 --budget 1)
   expect_contains("${err}" "${DIR}/ref.exr: size 32x24 differs from the render (16x12)")

@@ -9,6 +9,7 @@
 #include "cl/runtime.h"
 #include "cli/compare_command.h"
 #include "cli/converge_command.h"
+#include "image/error_stats.h"
 #include "image/image_io.h"
 #include "render/memory_budget.h"
 #include "render/renderer.h"
@@ -52,7 +53,7 @@ struct RenderArgs {
   std::optional<int> brdf_n_max;
   bool brdf_equal = false;
   std::optional<std::string> volume_importance;
-  std::string out, png, device, stats_json, heatmap;
+  std::string out, png, device, stats_json, heatmap, emitter_mask;
   bool stats = false;
 };
 
@@ -236,6 +237,16 @@ int run_render(const RenderArgs& args) {
           fmt::format("--heatmap: {}: is also the image output", printable(args.heatmap, 1024)));
     check_writable(h, "--heatmap");
   }
+  if (!args.emitter_mask.empty()) {
+    if (lower_ext(args.emitter_mask) != ".png")
+      throw SceneError(
+          fmt::format("--emitter-mask: {}: must end in .png", printable(args.emitter_mask, 1024)));
+    fs::path m(args.emitter_mask);
+    if (m == exr || m == png)
+      throw SceneError(fmt::format("--emitter-mask: {}: is also the image output",
+                                   printable(args.emitter_mask, 1024)));
+    check_writable(m, "--emitter-mask");
+  }
   if (!args.stats_json.empty()) check_writable(args.stats_json, "--stats-json");
 
   const std::string scene_name = printable(args.scene, 1024);
@@ -286,6 +297,8 @@ int run_render(const RenderArgs& args) {
              {"canopy:seed", std::to_string(scene.integrator.seed)}});
   write_png(png, img);
   if (!args.heatmap.empty()) write_png(args.heatmap, film.shadow_ray_heatmap());
+  if (!args.emitter_mask.empty())
+    write_png(args.emitter_mask, mask_to_image(film.emitter_mask(), film.width, film.height));
   const RenderStats& st = renderer.stats();
   std::string skipped = scene.skipped_lights
                             ? fmt::format(" ({} with zero emission skipped)", scene.skipped_lights)
@@ -411,6 +424,10 @@ int main(int argc, char** argv) {
   render->add_option("--stats-json", rargs.stats_json, "Write the statistics as JSON to FILE");
   render->add_option("--heatmap", rargs.heatmap,
                      "Write a PNG heat map of shadow rays per shading point (paper Fig. 18)");
+  render->add_option("--emitter-mask", rargs.emitter_mask,
+                     "Write a black/white PNG: white where a camera ray of the pixel hit an "
+                     "emitter directly (the pixels `canopy converge` leaves out of its "
+                     "non-emitter metrics)");
 
   CLI::App* info = app.add_subcommand("info", "List OpenCL platforms and devices");
   std::function<int()> action; // set by the subcommands defined in their own files
