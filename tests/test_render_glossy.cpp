@@ -124,6 +124,9 @@ double check_render(Scene& scene, const RendererOptions& opt, int spp, const Rad
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
   CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
+  // The reference is in world space: the loader put the camera at 0 (scene.origin).
+  cam.origin = make_float4(float(scene.origin.x), float(scene.origin.y), float(scene.origin.z),
+                           cam.origin.w);
   int violations = 0;
   double total_mean = 0, total_ref = 0, total_var = 0, total_quad = 0;
   for (int y = 0; y < film.height; ++y)
