@@ -30,9 +30,10 @@ using namespace canopy::test;
 namespace {
 
 // An occluder box between the point (at the origin, normal +y) and some of the lights; lights of
-// every type around and above it, some culled (below the horizon, facing away).
+// every type around and above it, some culled (below the horizon, facing away). The camera (not
+// rendered from) is at 0, so the scene origin is 0 and kP is a world point (Scene::origin).
 const char* kAreaScene = R"({
-  "camera": { "position": [0, 1, 5], "look_at": [0, 0, 0] },
+  "camera": { "position": [0, 0, 0], "look_at": [0, -1, -5] },
   "film": { "width": 4, "height": 4 },
   "materials": [ { "name": "white", "albedo": 0.5 } ],
   "shapes": [ { "type": "box", "material": "white", "min": [0.5, 0.6, -0.3], "max": [0.9, 0.7, 0.3] } ],
@@ -64,7 +65,7 @@ const char* kAreaScene = R"({
 
 // Point and spot lights only (the exact reference), the same occluder.
 const char* kDeltaScene = R"({
-  "camera": { "position": [0, 1, 5], "look_at": [0, 0, 0] },
+  "camera": { "position": [0, 0, 0], "look_at": [0, -1, -5] },
   "film": { "width": 4, "height": 4 },
   "materials": [ { "name": "white", "albedo": 0.5 } ],
   "shapes": [ { "type": "box", "material": "white", "min": [0.5, 0.6, -0.3], "max": [0.9, 0.7, 0.3] } ],

@@ -113,6 +113,9 @@ protected:
     for (const MaterialDesc& m : scene_.materials)
       materials_.push_back(m.gpu);
     geometry_ = build_scene_geometry(scene_, materials_);
+    // The loader stores coordinates relative to the camera position (Scene::origin); the points
+    // below are chosen in world space and shifted the same way.
+    origin_ = make_float3(float(scene_.origin.x), float(scene_.origin.y), float(scene_.origin.z));
     // "<sampler>-noorient": the orientation ablation (importance E / d^2); "brdf-mis-equal":
     // brdf-mis with equal allocation (BrdfSettings::adaptive = false); "-medium": the room half
     // filled with a coloured, forward-scattering medium (shade_volume and segment light picks)
@@ -122,8 +125,8 @@ protected:
       scene_.has_medium = true;
       scene_.medium.sigma_t = make_float4(0.35f, 0.5f, 0.7f, 0.4f);
       scene_.medium.sigma_s = make_float4(0.3f, 0.4f, 0.5f, 1.0f);
-      scene_.medium.bmin = make_float4(-3.5f, -0.5f, -3.5f, 0.0f);
-      scene_.medium.bmax = make_float4(3.5f, 1.6f, 0.5f, 0.0f);
+      scene_.medium.bmin = f4_from3(make_float3(-3.5f, -0.5f, -3.5f) - origin_, 0.0f);
+      scene_.medium.bmax = f4_from3(make_float3(3.5f, 1.6f, 0.5f) - origin_, 0.0f);
     }
     const std::string suffix = "-noorient", equal = "-equal";
     bool orientation = !name.ends_with(suffix);
@@ -146,7 +149,8 @@ protected:
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     Paths p;
     for (int i = 0; i < kPaths; ++i) {
-      float3 o = make_float3(-2.8f + 5.6f * u(rng), 0.1f + 2.8f * u(rng), -2.8f + 5.6f * u(rng));
+      float3 o =
+          make_float3(-2.8f + 5.6f * u(rng), 0.1f + 2.8f * u(rng), -2.8f + 5.6f * u(rng)) - origin_;
       float z = 2 * u(rng) - 1, phi = 6.2831853f * u(rng), s = std::sqrt(std::max(0.0f, 1 - z * z));
       float3 d = make_float3(s * std::cos(phi), z, s * std::sin(phi));
       Hit h;
@@ -159,8 +163,8 @@ protected:
       p.radiance.push_back(make_float4(u(rng), u(rng), u(rng), 0));
       p.rng.push_back(uint32_t(rng()));
       // Previous vertex: a point in the room, a normal, and the pdf of the BSDF ray (0: none).
-      p.shade_P.push_back(make_float4(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng),
-                                      i % 3 == 0 ? 0.0f : u(rng)));
+      float3 sp = make_float3(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng)) - origin_;
+      p.shade_P.push_back(f4_from3(sp, i % 3 == 0 ? 0.0f : u(rng)));
       p.shade_N.push_back(f4_from3(normalize(make_float3(u(rng) - 0.5f, 1.0f, u(rng) - 0.5f)), 0));
       // With a medium, some paths come from a medium vertex (MIS of the emission they find).
       p.shade_f.push_back(
@@ -174,7 +178,7 @@ protected:
       p.seg_beta.push_back(make_float4(0, 0, 0, 0));
       p.seg_phase.push_back(0.0f);
       // The segment of a previous medium vertex (for the MIS of emission found from it).
-      float3 so = make_float3(-2 + 4 * u(rng), 0.2f + 1.2f * u(rng), -2 + 4 * u(rng));
+      float3 so = make_float3(-2 + 4 * u(rng), 0.2f + 1.2f * u(rng), -2 + 4 * u(rng)) - origin_;
       p.scatter_seg_o.push_back(f4_from3(so, 0.5f + 3 * u(rng)));
       p.scatter_seg_d.push_back(
           f4_from3(normalize(make_float3(u(rng) - 0.5f, u(rng) - 0.5f, 1)), 0.5f * u(rng)));
@@ -211,6 +215,7 @@ protected:
 
   ClRuntime rt_;
   Scene scene_;
+  float3 origin_{0, 0, 0}; // scene_.origin in float
   std::vector<Material> materials_;
   SceneGeometry geometry_;
   LightSamplerData sampler_;

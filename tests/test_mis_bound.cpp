@@ -24,7 +24,7 @@ using canopy::test::HostPaths;
 namespace {
 
 constexpr const char* kLightsJson = R"({
-  "camera": { "position": [0, 0, 5], "look_at": [0, 0, 0] },
+  "camera": { "position": [0, 0, 0], "look_at": [0, 0, 1] },
   "film": { "width": 4, "height": 4 },
   "materials": [ { "name": "m", "albedo": 0.5 } ],
   "lights": [

@@ -16,6 +16,11 @@ Scene small_default_scene() {
   return s;
 }
 
+// A world position as the loaded scene stores it: relative to its origin (the camera position).
+float3 at(const Scene& s, float x, float y, float z) {
+  return make_float3(float(x - s.origin.x), float(y - s.origin.y), float(z - s.origin.z));
+}
+
 Film render(Scene& scene, const std::string& sampler, bool all_features, size_t wave_size,
             std::string* options = nullptr) {
   ClRuntime rt;
@@ -83,8 +88,8 @@ TEST_P(RenderFeatures, SceneWithMediumRendersTheSameImageWithEveryFeature) {
   scene.has_medium = true;
   scene.medium.sigma_t = make_float4(0.5f, 0.6f, 0.8f, 0.3f);
   scene.medium.sigma_s = make_float4(0.4f, 0.5f, 0.6f, 1.0f);
-  scene.medium.bmin = make_float4(-5, -1, -5, 0);
-  scene.medium.bmax = make_float4(5, 1, 5, 0);
+  scene.medium.bmin = f4_from3(at(scene, -5, -1, -5), 0);
+  scene.medium.bmax = f4_from3(at(scene, 5, 1, 5), 0);
   std::string minimal_opts;
   Film minimal = render(scene, GetParam(), false, 1 << 18, &minimal_opts);
   Film all = render(scene, GetParam(), true, 1 << 18);
@@ -128,9 +133,9 @@ TEST_P(RenderFeatures, SceneWithDisksRendersTheSameImageWithEveryFeature) {
   // The default scene plus a one-sided disk on the ceiling and a two-sided one in view: the
   // minimal build has the disk light and primitive but no sphere or point code.
   Scene scene = small_default_scene();
-  scene.lights.push_back(make_disk_light(make_float3(0.5f, 1.95f, 0.3f), make_float3(0, -1, 0),
-                                         0.3f, make_float3(4, 4, 3)));
-  scene.lights.push_back(make_disk_light(make_float3(-0.6f, 1.0f, 0.2f), make_float3(0.4f, 0.2f, 1),
+  scene.lights.push_back(make_disk_light(at(scene, 0.5f, 1.95f, 0.3f), make_float3(0, -1, 0), 0.3f,
+                                         make_float3(4, 4, 3)));
+  scene.lights.push_back(make_disk_light(at(scene, -0.6f, 1.0f, 0.2f), make_float3(0.4f, 0.2f, 1),
                                          0.25f, make_float3(1, 3, 2), true));
   std::string minimal_opts;
   Film minimal = render(scene, GetParam(), false, 1 << 18, &minimal_opts);

@@ -130,6 +130,14 @@ D3 pixel_reference(const CameraParams& cam, int px, int py, int n, const Radianc
   return acc * (1.0 / (n * n));
 }
 
+// The camera in world space, where the references are: the loader put it at 0 (scene.origin).
+CameraParams world_camera(const Scene& scene) {
+  CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
+  cam.origin = make_float4(float(scene.origin.x), float(scene.origin.y), float(scene.origin.z),
+                           cam.origin.w);
+  return cam;
+}
+
 // Renders the scene and checks every b x b block of pixels (b = `block`; 1: every pixel) against
 // reference(fine) within 5 standard errors plus |reference(fine) - reference(coarse)| (the
 // quadrature error), and the image total within its own bound. Returns the image-wide relative
@@ -145,7 +153,7 @@ double check_render(Scene& scene, const RendererOptions& opt, int spp, const Rad
   rs.seed = 5;
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
-  CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
+  CameraParams cam = world_camera(scene);
   // Per block and channel: sums of the pixel means, references, variances of the means and
   // quadrature errors.
   const int bw = (film.width + block - 1) / block, bh = (film.height + block - 1) / block;
@@ -480,7 +488,7 @@ TEST_P(MirrorAtDepthOne, ReflectsTheQuadLightExactly) {
   };
   // The reflection covers part of the image: a black image would fail.
   double lit = 0;
-  CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
+  CameraParams cam = world_camera(scene);
   for (int y = 0; y < scene.film.height; ++y)
     for (int x = 0; x < scene.film.width; ++x)
       lit += pixel_reference(cam, x, y, 4, mirror).x > 0 ? 1 : 0;

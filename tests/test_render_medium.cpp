@@ -323,11 +323,14 @@ struct Outcome {
 Outcome render_and_compare(ClRuntime& rt, const FogScene& s, const std::string& sampler, int spp,
                            int panels) {
   Scene scene = load_scene_from_string(scene_json(s, sampler), s.name + ".json", ".");
-  // The reference uses the lights as loaded and the coefficients as floats, in double.
+  // The reference uses the lights as loaded and the coefficients as floats, in double, in world
+  // space (the loader stores positions relative to the camera, scene.origin).
   Med m = med_of(s);
+  const V3 origin{scene.origin.x, scene.origin.y, scene.origin.z};
   std::vector<PointL> lights;
   for (const Light& l : scene.lights)
-    lights.push_back({v3(l.p), {double(l.emission.x), double(l.emission.y), double(l.emission.z)}});
+    lights.push_back(
+        {v3(l.p) + origin, {double(l.emission.x), double(l.emission.y), double(l.emission.z)}});
   EXPECT_EQ(lights.size(), s.lights.size());
 
   RendererOptions opt;
@@ -339,6 +342,7 @@ Outcome render_and_compare(ClRuntime& rt, const FogScene& s, const std::string& 
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
   CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
+  cam.origin = make_float4(float(origin.x), float(origin.y), float(origin.z), cam.origin.w);
   EXPECT_TRUE(lights_outside_the_frame(cam, lights, 2.0));
 
   const int W = film.width, H = film.height;

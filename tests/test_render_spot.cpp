@@ -142,12 +142,13 @@ Result render_spot(ClRuntime& rt, const SpotCase& c) {
       fmt::arg("cone", fmt_num(c.cone_deg)), fmt::arg("start", start));
   Scene scene = load_scene_from_string(json, "spot.json", ".");
   const Light& l = scene.lights.at(0);
-  // The reference uses the light as loaded (float position and direction), in double.
+  // The reference uses the light as loaded (float position and direction), in double, back in
+  // world space (the loader stores positions relative to the camera, scene.origin).
   Spot s;
   double dir[3] = {double(float(axis[0])), double(float(axis[1])), double(float(axis[2]))};
   double dl = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
   for (int k = 0; k < 3; ++k) {
-    s.p[k] = double((&l.p.x)[k]);
+    s.p[k] = double((&l.p.x)[k]) + (&scene.origin.x)[k];
     s.a[k] = dir[k] / dl;
   }
   s.omc_edge = omc_of(double(float(c.cone_deg)));
@@ -165,6 +166,8 @@ Result render_spot(ClRuntime& rt, const SpotCase& c) {
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
   CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
+  cam.origin = make_float4(float(scene.origin.x), float(scene.origin.y), float(scene.origin.z),
+                           cam.origin.w);
   Result r;
   for (int py = 0; py < kFilm; ++py)
     for (int px = 0; px < kFilm; ++px) {

@@ -409,7 +409,7 @@ TEST(SceneErrors, ZeroIntensityLightIsSkipped) {
                          kPointLight + "]"));
   ASSERT_EQ(s.lights.size(), 1u);
   EXPECT_EQ(s.skipped_lights, 1u);
-  EXPECT_EQ(s.lights[0].p.y, 2.0f); // the one that shines
+  EXPECT_EQ(world(s, s.lights[0].p).y, 2.0f); // the one that shines
 }
 
 TEST(SceneErrors, NegativeIntensityComponent) {

@@ -1,5 +1,6 @@
 // The shipped scenes load and contain what they promise.
 #include "scene/scene.h"
+#include "test_scene_util.h"
 
 #include <gtest/gtest.h>
 
@@ -9,6 +10,7 @@
 #include <sstream>
 
 using namespace canopy;
+using canopy::test::world;
 
 TEST(SceneFiles, DefaultLoads) {
   Scene s = load_scene(std::filesystem::path(CANOPY_SCENES_DIR) / "default.json");
@@ -21,7 +23,7 @@ TEST(SceneFiles, DefaultLoads) {
     EXPECT_EQ(l.type, LIGHT_QUAD);
     EXPECT_FLOAT_EQ(l.n.y, -1.0f); // facing down into the box
     EXPECT_NEAR(l.n.w, 0.03f * 0.03f, 1e-7f);
-    EXPECT_LT(l.p.y, 2.0f);
+    EXPECT_LT(world(s, l.p).y, 2.0f);
   }
   // 5 walls (2 triangles each) + 2 boxes (12 each).
   EXPECT_EQ(s.triangle_count(), 10u + 24u);
@@ -41,8 +43,10 @@ TEST(SceneFiles, Spiral10kLoads) {
   EXPECT_EQ(s.triangle_count(), 2u + 10000u * 12u);
   for (const Light& l : s.lights) {
     EXPECT_EQ(l.type, LIGHT_POINT);
-    EXPECT_FLOAT_EQ(l.p.y, 0.1f);
-    float r = std::sqrt(l.p.x * l.p.x + l.p.z * l.p.z);
+    float3 p = world(s, l.p);
+    // Stored relative to the camera (14 units above): float precision of that distance.
+    EXPECT_NEAR(p.y, 0.1f, 2e-6f);
+    float r = std::sqrt(p.x * p.x + p.z * p.z);
     EXPECT_GE(r, 0.5f - 1e-4f);
     EXPECT_LE(r, 10.0f + 1e-4f);
   }

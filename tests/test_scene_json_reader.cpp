@@ -259,7 +259,10 @@ TEST(JsonReader, ManyLightsRoundTripExactly) {
                           "\"intensity\": {:.9g}}}",
                           i ? ",\n" : "", x[0], x[1], x[2], x[3]);
   }
-  Scene s = load_str(scene_with("", lights + "]"));
+  // The camera at 0 makes the scene origin 0: positions are stored as parsed, not rebased.
+  Scene s = load_str(R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, -1]}, "lights": )" +
+                     lights + "]}");
+  ASSERT_EQ(s.origin.x, 0.0);
   ASSERT_EQ(s.lights.size(), size_t(n));
   for (int i = 0; i < n; ++i) {
     const float* x = &v[size_t(i) * 4];

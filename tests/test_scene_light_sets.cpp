@@ -12,9 +12,18 @@ using namespace canopy::test;
 
 namespace {
 
+// The scene with its light positions and vertices back in world space (the loader stores them
+// relative to the camera position, Scene::origin), as the tests below state them.
 Scene with_sets(const std::string& sets, const std::string& more = "") {
   std::string members = more.empty() ? "" : more + ", ";
-  return load_str(scene_with(members + "\"light_sets\": " + sets, ""));
+  Scene s = load_str(scene_with(members + "\"light_sets\": " + sets, ""));
+  for (Light& l : s.lights) {
+    float3 w = world(s, l.p);
+    l.p = make_float4(w.x, w.y, w.z, l.p.w);
+  }
+  for (float3& v : s.vertices)
+    v = world(s, v);
+  return s;
 }
 
 bool same_lights(const Scene& a, const Scene& b) {

@@ -2,6 +2,8 @@
 #include "scene/metal_presets.h"
 #include "test_scene_util.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <set>
 
@@ -34,9 +36,15 @@ TEST(SceneLoader, CameraFilmIntegrator) {
                    "split_threshold": 0.5, "max_cut": 9, "seed": 4294967295, "mis": false},
     "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}]
   })");
-  EXPECT_FLOAT_EQ(s.camera.position.x, 1);
-  EXPECT_FLOAT_EQ(s.camera.position.y, 2);
-  EXPECT_FLOAT_EQ(s.camera.position.z, 3);
+  // The camera position is the scene origin (scene.h): the camera sits at 0.
+  EXPECT_EQ(s.origin.x, 1.0);
+  EXPECT_EQ(s.origin.y, 2.0);
+  EXPECT_EQ(s.origin.z, 3.0);
+  EXPECT_EQ(s.camera.position.x, 0.0f);
+  EXPECT_EQ(s.camera.position.y, 0.0f);
+  EXPECT_EQ(s.camera.position.z, 0.0f);
+  EXPECT_FLOAT_EQ(s.camera.look_at.x, -1);
+  EXPECT_FLOAT_EQ(s.camera.look_at.z, -3);
   EXPECT_FLOAT_EQ(s.camera.up.z, 1);
   EXPECT_FLOAT_EQ(s.camera.fov_y_deg, 60);
   EXPECT_EQ(s.film.width, 320);
@@ -229,8 +237,8 @@ TEST(SceneLoader, PointAndSpot) {
   EXPECT_EQ(p.type, LIGHT_POINT);
   EXPECT_EQ(p.prim, -1);
   EXPECT_EQ(p.flags, 0);
-  EXPECT_FLOAT_EQ(p.p.x, 1);
-  EXPECT_FLOAT_EQ(p.p.z, 3);
+  EXPECT_FLOAT_EQ(world(s, p.p).x, 1);
+  EXPECT_FLOAT_EQ(world(s, p.p).z, 3);
   EXPECT_FLOAT_EQ(p.emission.x, 4);
   EXPECT_FLOAT_EQ(p.emission.z, 6);
   const Light& sp = s.lights[1];
@@ -256,8 +264,8 @@ TEST(SceneLoader, Disk) {
   EXPECT_EQ(d.type, LIGHT_DISK);
   EXPECT_EQ(d.prim, -1);
   EXPECT_EQ(d.flags, 0);
-  EXPECT_FLOAT_EQ(d.p.x, 1);
-  EXPECT_FLOAT_EQ(d.p.z, 3);
+  EXPECT_FLOAT_EQ(world(s, d.p).x, 1);
+  EXPECT_FLOAT_EQ(world(s, d.p).z, 3);
   EXPECT_FLOAT_EQ(d.p.w, 0.5f);               // radius
   EXPECT_FLOAT_EQ(d.n.y, -1);                 // unit normal
   EXPECT_FLOAT_EQ(d.n.w, float(M_PI * 0.25)); // area
@@ -293,13 +301,13 @@ TEST(SceneLoader, SphereQuadTriangle) {
   ASSERT_EQ(s.lights.size(), 4u);
   const Light& sp = s.lights[0];
   EXPECT_EQ(sp.type, LIGHT_SPHERE);
-  EXPECT_FLOAT_EQ(sp.p.y, 2);
+  EXPECT_FLOAT_EQ(world(s, sp.p).y, 2);
   EXPECT_FLOAT_EQ(sp.p.w, 0.5f);
   EXPECT_FLOAT_EQ(sp.emission.z, 3);
   const Light& q = s.lights[1];
   EXPECT_EQ(q.type, LIGHT_QUAD);
   EXPECT_EQ(q.flags, 0);
-  EXPECT_FLOAT_EQ(q.p.y, 2);
+  EXPECT_FLOAT_EQ(world(s, q.p).y, 2);
   EXPECT_FLOAT_EQ(q.e1.x, 2);
   EXPECT_FLOAT_EQ(q.e2.z, 3);
   // cross([2,0,0], [0,0,3]) = [0,-6,0]: facing down, area 6.
@@ -334,7 +342,7 @@ TEST(SceneLoader, QuadAndBoxShapes) {
     EXPECT_FLOAT_EQ(tri_normal(s, t).y, 1.0f);
   for (size_t t = 2; t < 14; ++t) {
     // Outward: the normal points away from the box centre (the origin).
-    EXPECT_GT(dot(tri_normal(s, t), tri_centroid(s, t)), 0.0f) << "triangle " << t;
+    EXPECT_GT(dot(tri_normal(s, t), world(s, tri_centroid(s, t))), 0.0f) << "triangle " << t;
     EXPECT_EQ(s.triangle_light[t], -1);
   }
   EXPECT_EQ(s.vertices.size(), 4u + 24u);
@@ -345,7 +353,8 @@ TEST(SceneLoader, BoxRotateY) {
       {"type": "box", "min": [1, 0, -1], "max": [3, 1, 1], "rotate_y": 90}])"));
   // Rotation about the box's own vertical axis (x = 2, z = 0): x extent becomes [1.0, 3.0] in z
   // terms: the 2 x 1 x 2 box is square in xz, so its footprint stays [1,3] x [-1,1].
-  for (const float3& v : s.vertices) {
+  for (const float3& rv : s.vertices) {
+    float3 v = world(s, rv);
     EXPECT_NEAR(std::fabs(v.x - 2.0f), 1.0f, 1e-5f);
     EXPECT_NEAR(std::fabs(v.z), 1.0f, 1e-5f);
   }
@@ -359,11 +368,11 @@ TEST(SceneLoader, TransformOrder) {
                      "translate": [10, 0, 0]}}])"));
   ASSERT_EQ(s.vertices.size(), 3u);
   // (1,0,0) -> (2,0,0) -> (0,2,0) -> (10,2,0)
-  EXPECT_NEAR(s.vertices[1].x, 10.0f, 1e-5f);
-  EXPECT_NEAR(s.vertices[1].y, 2.0f, 1e-5f);
+  EXPECT_NEAR(world(s, s.vertices[1]).x, 10.0f, 1e-5f);
+  EXPECT_NEAR(world(s, s.vertices[1]).y, 2.0f, 1e-5f);
   // (0,1,0) -> (0,2,0) -> (-2,0,0) -> (8,0,0)
-  EXPECT_NEAR(s.vertices[2].x, 8.0f, 1e-5f);
-  EXPECT_NEAR(s.vertices[2].y, 0.0f, 1e-5f);
+  EXPECT_NEAR(world(s, s.vertices[2]).x, 8.0f, 1e-5f);
+  EXPECT_NEAR(world(s, s.vertices[2]).y, 0.0f, 1e-5f);
 }
 
 TEST(SceneLoader, MirrorKeepsNormalMeaning) {
@@ -514,8 +523,8 @@ TEST(SceneLoader, Medium) {
   EXPECT_FLOAT_EQ(s.medium.sigma_t.w, -0.4f); // g
   EXPECT_FLOAT_EQ(s.medium.sigma_s.y, 0.5f);
   EXPECT_EQ(s.medium.sigma_s.w, 1.0f); // bounded
-  EXPECT_FLOAT_EQ(s.medium.bmin.z, -3.0f);
-  EXPECT_FLOAT_EQ(s.medium.bmax.y, 2.0f);
+  EXPECT_FLOAT_EQ(world(s, s.medium.bmin).z, -3.0f);
+  EXPECT_FLOAT_EQ(world(s, s.medium.bmax).y, 2.0f);
   EXPECT_EQ(s.integrator.volume_importance, "segment");
 
   Scene u = load_str(head + R"("medium": {"sigma_a": 0, "sigma_s": [0, 0.1, 0]},
@@ -528,4 +537,67 @@ TEST(SceneLoader, Medium) {
   // sigma_t = 0: vacuum, no medium at all
   EXPECT_FALSE(load_str(head + R"("medium": {"sigma_a": 0, "sigma_s": 0}})").has_medium);
   EXPECT_FALSE(load_str(head.substr(0, head.size() - 2) + "}").has_medium);
+}
+
+// Far from the origin (issue 20): every coordinate is stored relative to the camera position,
+// subtracted in double before the rounding to float, so it keeps the precision of its distance
+// from the camera. At 1e6, float world coordinates would be 1/16 apart.
+TEST(SceneLoader, RebasesEveryCoordinateToTheCamera) {
+  const double T[3] = {1e6, -2e5, 3e6};
+  auto v = [&](double x, double y, double z) {
+    return fmt::format("[{:.17g}, {:.17g}, {:.17g}]", T[0] + x, T[1] + y, T[2] + z);
+  };
+  Scene s = load_str(fmt::format(
+      R"({{"camera": {{"position": {}, "look_at": {}}},
+    "medium": {{"sigma_a": 0.1, "sigma_s": 0, "bounds": {{"min": {}, "max": {}}}}},
+    "shapes": [
+      {{"type": "quad", "corner": {}, "edge1": [0.2, 0, 0], "edge2": [0, 0, 0.3]}},
+      {{"type": "box", "min": {}, "max": {}}},
+      {{"type": "obj", "file": "triangle.obj", "transform": {{"translate": {}}}}}],
+    "lights": [
+      {{"type": "point", "position": {}, "intensity": 1}},
+      {{"type": "sphere", "center": {}, "radius": 0.05, "radiance": 1}},
+      {{"type": "triangle", "v0": {}, "v1": {}, "v2": {}, "radiance": 1}}],
+    "light_sets": [{{"type": "grid", "origin": {}, "edge1": [0.2, 0, 0], "edge2": [0, 0, 0.2],
+      "nx": 1, "ny": 1, "light": {{"type": "point", "intensity": 1}},
+      "instance": {{"type": "quad", "corner": [-0.05, 0, -0.05], "edge1": [0.1, 0, 0],
+                    "edge2": [0, 0, 0.1]}}}}]}})",
+      v(0.3, 1.7, 5.1), v(0.3, 0.7, 0.1), v(-0.13, -0.17, -0.19), v(0.23, 0.29, 0.31),
+      v(0.1, 0.3, 0.7), v(-0.33, 0.11, 0.21), v(-0.13, 0.37, 0.43), v(0.17, 0.19, 0.23),
+      v(0.43, 1.1, 0.7), v(-0.3, 0.9, 0.3), v(0.1, 0.1, 0.1), v(0.3, 0.1, 0.1), v(0.1, 0.1, 0.4),
+      v(0.7, 1.3, 0.9)));
+  EXPECT_EQ(s.origin.x, T[0] + 0.3);
+  EXPECT_EQ(s.origin.y, T[1] + 1.7);
+  EXPECT_EQ(s.origin.z, T[2] + 5.1);
+  EXPECT_EQ(s.camera.position.x, 0.0f);
+  // Relative to the camera at (0.3, 1.7, 5.1) + T; a float error of 1e-6 is the rounding of a
+  // coordinate of a few units.
+  auto expect_at = [&](float3 got, double x, double y, double z, const char* what) {
+    EXPECT_NEAR(got.x, x - 0.3, 1e-6) << what;
+    EXPECT_NEAR(got.y, y - 1.7, 1e-6) << what;
+    EXPECT_NEAR(got.z, z - 5.1, 1e-6) << what;
+  };
+  expect_at(s.camera.look_at, 0.3, 0.7, 0.1, "look_at");
+  expect_at(xyz_of(s.medium.bmin), -0.13, -0.17, -0.19, "medium min");
+  expect_at(xyz_of(s.medium.bmax), 0.23, 0.29, 0.31, "medium max");
+  ASSERT_EQ(s.vertices.size(), 4u + 24u + 3u + 4u);
+  expect_at(s.vertices[0], 0.1, 0.3, 0.7, "quad corner");
+  expect_at(s.vertices[2], 0.3, 0.3, 1.0, "quad corner + edges");
+  float3 lo = s.vertices[4], hi = s.vertices[4];
+  for (size_t i = 4; i < 28; ++i) {
+    lo = fmin(lo, s.vertices[i]);
+    hi = fmax(hi, s.vertices[i]);
+  }
+  expect_at(lo, -0.33, 0.11, 0.21, "box min");
+  expect_at(hi, -0.13, 0.37, 0.43, "box max");
+  expect_at(s.vertices[29], 1.17, 0.19, 0.23, "obj vertex (1, 0, 0) translated");
+  expect_at(s.vertices[31], 0.75, 1.3, 0.95, "light-set instance corner");
+  ASSERT_EQ(s.lights.size(), 4u);
+  expect_at(xyz_of(s.lights[0].p), 0.43, 1.1, 0.7, "point light");
+  expect_at(xyz_of(s.lights[1].p), -0.3, 0.9, 0.3, "sphere light");
+  expect_at(xyz_of(s.lights[2].p), 0.1, 0.1, 0.1, "triangle light v0");
+  EXPECT_NEAR(s.lights[2].e1.x, 0.2, 1e-7);
+  EXPECT_NEAR(s.lights[2].e2.z, 0.3, 1e-7);
+  EXPECT_NEAR(s.lights[2].n.w, 0.03, 1e-7); // area
+  expect_at(xyz_of(s.lights[3].p), 0.8, 1.3, 1.0, "light-set site");
 }

@@ -13,6 +13,16 @@ namespace canopy::test {
 inline const char* kCamera = R"("camera": {"position": [0, 1, 5], "look_at": [0, 1, 0]})";
 inline const char* kPointLight = R"({"type": "point", "position": [0, 2, 0], "intensity": 1})";
 
+// A loaded coordinate in world space: the loader stores coordinates relative to s.origin, the
+// camera position (scene.h).
+inline float3 world(const Scene& s, float3 p) {
+  return make_float3(float(double(p.x) + s.origin.x), float(double(p.y) + s.origin.y),
+                     float(double(p.z) + s.origin.z));
+}
+inline float3 world(const Scene& s, float4 p) {
+  return world(s, xyz_of(p));
+}
+
 // Loads a scene from a string, named "scene.json", relative paths against tests/data.
 inline Scene load_str(const std::string& json) {
   return load_scene_from_string(json, "scene.json", CANOPY_TEST_DATA_DIR);

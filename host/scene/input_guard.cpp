@@ -127,30 +127,33 @@ std::string read_input_file(const std::filesystem::path& file, uint64_t max_byte
   return text;
 }
 
-std::string check_coordinate(float3 p) {
+std::string check_coordinate(float3 p, double3 origin) {
   const float c[3] = {p.x, p.y, p.z};
   for (float x : c)
-    if (!(std::fabs(x) <= kMaxCoordinate))
+    if (!(std::fabs(x) <= kMaxCoordinate)) {
+      // The user knows the world position, not the rebased one: quote that, at float precision.
+      float3 w = to_float3(dvec(p) + origin);
       return fmt::format("[{}, {}, {}] is outside the supported coordinate range |x| <= {:g} "
                          "(docs/limits.md)",
-                         p.x, p.y, p.z, double(kMaxCoordinate));
+                         w.x, w.y, w.z, double(kMaxCoordinate));
+    }
   return {};
 }
 
-std::string check_light_extent(const Light& l) {
+std::string check_light_extent(const Light& l, double3 origin) {
   float3 p = xyz_of(l.p);
   std::string e;
   switch (l.type) {
   case LIGHT_SPHERE: {
     float r = l.p.w;
     for (float3 q : {p + make_float3(r, r, r), p - make_float3(r, r, r)})
-      if (!(e = check_coordinate(q)).empty()) return "its bounds " + e;
+      if (!(e = check_coordinate(q, origin)).empty()) return "its bounds " + e;
     return {};
   }
   case LIGHT_DISK: {
     float r = l.p.w;
     for (float3 q : {p + make_float3(r, r, r), p - make_float3(r, r, r)})
-      if (!(e = check_coordinate(q)).empty()) return "its bounds " + e;
+      if (!(e = check_coordinate(q, origin)).empty()) return "its bounds " + e;
     return {};
   }
   case LIGHT_QUAD:
@@ -159,11 +162,11 @@ std::string check_light_extent(const Light& l) {
     float3 corners[4] = {p, p + e1, p + e2, p + e1 + e2};
     int nc = l.type == LIGHT_QUAD ? 4 : 3;
     for (int i = 0; i < nc; ++i)
-      if (!(e = check_coordinate(corners[i])).empty()) return "a corner " + e;
+      if (!(e = check_coordinate(corners[i], origin)).empty()) return "a corner " + e;
     return {};
   }
   default:
-    if (!(e = check_coordinate(p)).empty()) return "its position " + e;
+    if (!(e = check_coordinate(p, origin)).empty()) return "its position " + e;
     return {};
   }
 }

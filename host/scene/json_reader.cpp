@@ -755,6 +755,18 @@ float3 JsonValue::as_vec3() const {
   return make_float3(c[0], c[1], c[2]);
 }
 
+double3 JsonValue::as_dvec3() const {
+  if (!is_array() || node().n != 3) fail("must be an array of 3 numbers");
+  double c[3];
+  for (size_t i = 0; i < 3; ++i) {
+    // The range of as_float: the same inputs are accepted whether kept in double or not.
+    JsonValue e = at(i);
+    c[i] = e.as_double();
+    if (std::fabs(c[i]) > double(std::numeric_limits<float>::max())) e.fail("must be finite");
+  }
+  return {c[0], c[1], c[2]};
+}
+
 float3 JsonValue::as_vec3_nonzero() const {
   float3 v = as_vec3();
   if (v.x == 0.0f && v.y == 0.0f && v.z == 0.0f) fail("must not be the zero vector");

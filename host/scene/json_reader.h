@@ -115,6 +115,9 @@ public:
   // Vectors: an array of 3 finite numbers.
   float3 as_vec3() const;
   float3 as_vec3_nonzero() const;
+  // The same checks, kept in double: positions, which the loader rounds to float only after
+  // subtracting the scene origin (Scene::origin).
+  double3 as_dvec3() const;
   // Colours: a number (grey) or an array of 3 numbers, every component >= 0.
   float3 as_color() const;
   // An emission: components >= 0; black means switched off (the loader skips such a light).

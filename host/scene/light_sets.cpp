@@ -39,12 +39,13 @@ Variation parse_variation(const JsonValue& v) {
   return var;
 }
 
-// Moves a template light to a site.
-inline Light place(const Light& t, float3 site) {
+// Moves a template light to a site (a world position), rebased to the scene origin in double.
+inline Light place(const Light& t, double3 site, double3 origin) {
   Light l = t;
-  l.p.x += site.x;
-  l.p.y += site.y;
-  l.p.z += site.z;
+  double3 p = site - origin;
+  l.p.x = to_float(double(t.p.x) + p.x);
+  l.p.y = to_float(double(t.p.y) + p.y);
+  l.p.z = to_float(double(t.p.z) + p.z);
   return l;
 }
 
@@ -53,7 +54,7 @@ inline Light place(const Light& t, float3 site) {
 void expand_light_set(const JsonValue& v, Builder& b) {
   auto o = v.as_object();
   std::string type = o.req("type").as_enum({"grid", "random_box", "spiral", "mesh_surface"});
-  Light tmpl = parse_light(o.req("light"), /*is_template=*/true);
+  Light tmpl = parse_light(o.req("light"), /*is_template=*/true, double3{});
   uint32_t seed = 1;
   if (auto s = o.get("seed")) seed = uint32_t(s->as_int(0, 0xffffffffLL));
   Variation var;
@@ -64,16 +65,18 @@ void expand_light_set(const JsonValue& v, Builder& b) {
   // A count of 0 is accepted (a set switched off); nx and ny, when given, are >= 1.
   auto count_of = [&](const char* key) { return o.req(key).as_int(0, kMaxLights); };
 
-  std::vector<float3> sites;
+  // World positions in double, rebased when the lights and instances are placed.
+  std::vector<double3> sites;
   std::vector<float3> normals; // mesh_surface only
+  const double3 scene_origin = b.scene.origin;
   Pcg32 rng(seed, 0x5eed);
 
   if (type == "grid") {
     o.allow({"type", "light", "instance", "seed", "variation", "count", "nx", "ny", "origin",
              "edge1", "edge2"});
-    float3 origin = o.req("origin").as_vec3();
-    float3 e1 = o.req("edge1").as_vec3();
-    float3 e2 = o.req("edge2").as_vec3();
+    double3 origin = o.req("origin").as_dvec3();
+    double3 e1 = o.req("edge1").as_dvec3();
+    double3 e2 = o.req("edge2").as_dvec3();
     int64_t nx, ny, count;
     if (o.has("nx") || o.has("ny")) {
       if (o.has("count")) o.req("count").fail("give either count or nx and ny, not both");
@@ -91,29 +94,29 @@ void expand_light_set(const JsonValue& v, Builder& b) {
       float fy = (float(j) + 0.5f) / float(ny);
       for (int64_t i = 0; i < nx && int64_t(sites.size()) < count; ++i) {
         float fx = (float(i) + 0.5f) / float(nx);
-        sites.push_back(origin + e1 * fx + e2 * fy);
+        sites.push_back(origin + e1 * double(fx) + e2 * double(fy));
       }
     }
   } else if (type == "random_box") {
     o.allow({"type", "light", "instance", "seed", "variation", "count", "min", "max"});
-    float3 lo = o.req("min").as_vec3();
+    double3 lo = o.req("min").as_dvec3();
     auto maxv = o.req("max");
-    float3 hi = maxv.as_vec3();
+    double3 hi = maxv.as_dvec3();
     if (!(hi.x >= lo.x && hi.y >= lo.y && hi.z >= lo.z))
       maxv.fail("must be >= min in every component");
     int64_t count = count_of("count");
-    float3 ext = hi - lo;
+    double3 ext = hi - lo;
     sites.resize(size_t(count));
     for (auto& s : sites) {
-      float ux = rng.uniform(), uy = rng.uniform(), uz = rng.uniform();
-      s = make_float3(lo.x + ext.x * ux, lo.y + ext.y * uy, lo.z + ext.z * uz);
+      double ux = rng.uniform(), uy = rng.uniform(), uz = rng.uniform();
       // Rounding could land exactly on hi only, never outside [lo, hi].
-      s = fmin(fmax(s, lo), hi);
+      s = {std::clamp(lo.x + ext.x * ux, lo.x, hi.x), std::clamp(lo.y + ext.y * uy, lo.y, hi.y),
+           std::clamp(lo.z + ext.z * uz, lo.z, hi.z)};
     }
   } else if (type == "spiral") {
     o.allow({"type", "light", "instance", "seed", "variation", "count", "center", "radius",
              "inner_radius", "turns", "height"});
-    float3 c = o.req("center").as_vec3();
+    double3 c = o.req("center").as_dvec3();
     float r1 = o.req("radius").as_float_positive();
     float r0 = 0.0f;
     if (auto iv = o.get("inner_radius")) {
@@ -132,8 +135,8 @@ void expand_light_set(const JsonValue& v, Builder& b) {
       double r = std::sqrt(double(r0) * r0 + (double(r1) * r1 - double(r0) * r0) * t);
       double f = (r - r0) / (double(r1) - r0); // 0..1 along the spiral
       double phi = two_pi * double(turns) * f;
-      sites[size_t(i)] = make_float3(c.x + float(r * std::cos(phi)), c.y + float(height * f),
-                                     c.z + float(r * std::sin(phi)));
+      sites[size_t(i)] = {c.x + r * std::cos(phi), c.y + double(height) * f,
+                          c.z + r * std::sin(phi)};
     }
   } else { // mesh_surface
     o.allow({"type", "light", "instance", "seed", "variation", "count", "shape", "offset",
@@ -182,7 +185,8 @@ void expand_light_set(const JsonValue& v, Builder& b) {
       float su = std::sqrt(rng.uniform()), w = rng.uniform();
       float b0 = 1.0f - su, b1 = su * (1.0f - w), b2 = su * w;
       float3 n = normalize(cross(bb - a, c - a));
-      sites[size_t(i)] = a * b0 + bb * b1 + c * b2 + n * offset;
+      // The vertices are rebased already: back to world, like the other sites.
+      sites[size_t(i)] = dvec(a * b0 + bb * b1 + c * b2 + n * offset) + scene_origin;
       normals[size_t(i)] = n;
     }
     if (!align) normals.clear();
@@ -196,7 +200,7 @@ void expand_light_set(const JsonValue& v, Builder& b) {
   lights.reserve(lights.size() + n);
   Pcg32 vrng(seed, 0xc010);
   for (size_t i = 0; i < n; ++i) {
-    Light l = place(tmpl, sites[i]);
+    Light l = place(tmpl, sites[i], scene_origin);
     if (!normals.empty() && l.type == LIGHT_DISK) {
       // the disk faces along the surface normal
       if (!finish_disk_light(l, normals[i]))
@@ -220,7 +224,7 @@ void expand_light_set(const JsonValue& v, Builder& b) {
     if (!std::isfinite(l.emission.x) || !std::isfinite(l.emission.y) ||
         !std::isfinite(l.emission.z))
       v.fail(fmt::format("light {} (of {}) has a non-finite emission", i + 1, n));
-    if (auto e = check_light_extent(l); !e.empty())
+    if (auto e = check_light_extent(l, scene_origin); !e.empty())
       v.fail(fmt::format("light {} (of {}): {}", i + 1, n, e));
     if (emits(l))
       lights.push_back(l);

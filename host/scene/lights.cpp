@@ -56,17 +56,20 @@ void set_spot_cone(Light& l, double cone_deg, double start_deg) {
 
 namespace {
 
-float3 vec_or(const JsonObject& o, std::string_view key, bool is_template, float3 def) {
+// A position: as a template an offset from the site (`def` if omitted), else a world position
+// rebased to `origin` in double before it is rounded.
+float3 position(const JsonObject& o, std::string_view key, bool is_template, float3 def,
+                double3 origin) {
   if (is_template) {
     auto v = o.get(key);
     return v ? v->as_vec3() : def;
   }
-  return o.req(key).as_vec3();
+  return rebase(o.req(key).as_dvec3(), origin);
 }
 
 } // namespace
 
-Light parse_light(const JsonValue& v, bool is_template) {
+Light parse_light(const JsonValue& v, bool is_template, double3 origin) {
   auto o = v.as_object();
   std::string type = o.req("type").as_enum({"point", "spot", "sphere", "quad", "triangle", "disk"});
   Light l{};
@@ -75,12 +78,12 @@ Light parse_light(const JsonValue& v, bool is_template) {
   if (type == "point") {
     o.allow({"type", "position", "intensity"});
     l.type = LIGHT_POINT;
-    l.p = f4_from3(vec_or(o, "position", is_template, zero), 0.0f);
+    l.p = f4_from3(position(o, "position", is_template, zero, origin), 0.0f);
     l.emission = f4_from3(o.req("intensity").as_emission(), 0.0f);
   } else if (type == "spot") {
     o.allow({"type", "position", "direction", "intensity", "cone_angle", "falloff_start"});
     l.type = LIGHT_SPOT;
-    l.p = f4_from3(vec_or(o, "position", is_template, zero), 0.0f);
+    l.p = f4_from3(position(o, "position", is_template, zero, origin), 0.0f);
     float3 dir = normalize(o.req("direction").as_vec3_nonzero());
     if (!std::isfinite(dir.x) || !std::isfinite(dir.y) || !std::isfinite(dir.z))
       o.req("direction").fail("cannot be normalised");
@@ -98,7 +101,7 @@ Light parse_light(const JsonValue& v, bool is_template) {
   } else if (type == "sphere") {
     o.allow({"type", "center", "radius", "radiance"});
     l.type = LIGHT_SPHERE;
-    float3 c = vec_or(o, "center", is_template, zero);
+    float3 c = position(o, "center", is_template, zero, origin);
     float r = o.req("radius").as_float_positive();
     l.p = f4_from3(c, r);
     l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
@@ -108,7 +111,7 @@ Light parse_light(const JsonValue& v, bool is_template) {
     float3 e1 = o.req("edge1").as_vec3();
     float3 e2 = o.req("edge2").as_vec3();
     // As a template, the quad is centred on the generated site unless a corner offset is given.
-    float3 corner = vec_or(o, "corner", is_template, (e1 + e2) * -0.5f);
+    float3 corner = position(o, "corner", is_template, (e1 + e2) * -0.5f, origin);
     l.p = f4_from3(corner, 0.0f);
     l.e1 = f4_from3(e1, 0.0f);
     l.e2 = f4_from3(e2, 0.0f);
@@ -119,7 +122,7 @@ Light parse_light(const JsonValue& v, bool is_template) {
     o.allow({"type", "center", "normal", "radius", "radiance", "two_sided"});
     l.type = LIGHT_DISK;
     // As a template, the disk is centred on the generated site unless a centre offset is given.
-    float3 c = vec_or(o, "center", is_template, zero);
+    float3 c = position(o, "center", is_template, zero, origin);
     float3 normal = o.req("normal").as_vec3_nonzero();
     float r = o.req("radius").as_float_positive();
     l.p = f4_from3(c, r);
@@ -130,10 +133,11 @@ Light parse_light(const JsonValue& v, bool is_template) {
   } else { // triangle
     o.allow({"type", "v0", "v1", "v2", "radiance", "two_sided"});
     l.type = LIGHT_TRIANGLE;
-    float3 v0 = o.req("v0").as_vec3(), v1 = o.req("v1").as_vec3(), v2 = o.req("v2").as_vec3();
-    l.p = f4_from3(v0, 0.0f);
-    l.e1 = f4_from3(v1 - v0, 0.0f);
-    l.e2 = f4_from3(v2 - v0, 0.0f);
+    // The edges in double: each rounded once, whatever the vertices' distance from the origin.
+    double3 v0 = o.req("v0").as_dvec3(), v1 = o.req("v1").as_dvec3(), v2 = o.req("v2").as_dvec3();
+    l.p = f4_from3(rebase(v0, is_template ? double3{} : origin), 0.0f);
+    l.e1 = f4_from3(to_float3(v1 - v0), 0.0f);
+    l.e2 = f4_from3(to_float3(v2 - v0), 0.0f);
     l.flags = o.get_bool("two_sided", false) ? LIGHT_FLAG_TWO_SIDED : 0;
     l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
     if (!finish_area_light(l)) o.fail("area must be > 0 (the vertices are collinear)");

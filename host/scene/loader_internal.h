@@ -5,13 +5,47 @@
 #include "scene/json_reader.h"
 #include "scene/scene.h"
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
 
+namespace canopy {
+
+inline double3 operator+(double3 a, double3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+inline double3 operator-(double3 a, double3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+inline double3 operator*(double3 a, double s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+
+} // namespace canopy
+
 namespace canopy::detail {
+
+inline double3 dvec(float3 v) {
+  return {double(v.x), double(v.y), double(v.z)};
+}
+// Rounded to float; beyond the float range +-inf (a plain conversion would be undefined), which
+// the coordinate checks then refuse.
+inline float to_float(double v) {
+  if (std::fabs(v) > double(std::numeric_limits<float>::max()))
+    return v > 0 ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+  return float(v);
+}
+inline float3 to_float3(double3 v) {
+  return make_float3(to_float(v.x), to_float(v.y), to_float(v.z));
+}
+// A world position as the renderer stores it: relative to the scene origin, rounded once.
+inline float3 rebase(double3 p, double3 origin) {
+  return to_float3(p - origin);
+}
 
 // PCG32 (O'Neill): small, fast, and the same sequence on every platform and compiler (unlike the
 // std:: distributions), so a seed means the same scene everywhere.
@@ -35,22 +69,25 @@ struct Pcg32 {
 };
 
 // Affine transform: world = M * local + t. `flips` when det(M) < 0 (winding is swapped so the
-// geometric normal keeps its meaning).
+// geometric normal keeps its meaning). In double: t holds world positions (a shape's corner, a
+// light-set site, a JSON translate) that are rounded to float only after the scene origin is
+// subtracted (Builder::add_mesh).
 struct Transform {
-  float m[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  float3 t{0, 0, 0};
+  double m[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  double3 t;
 
-  float3 apply(float3 p) const {
-    return make_float3(m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + t.x,
-                       m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + t.y,
-                       m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + t.z);
+  double3 apply(double3 p) const {
+    return {m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + t.x,
+            m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + t.y,
+            m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + t.z};
   }
-  float det() const {
+  double3 apply(float3 p) const { return apply(dvec(p)); }
+  double det() const {
     return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
            m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
            m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
   }
-  bool flips() const { return det() < 0.0f; }
+  bool flips() const { return det() < 0.0; }
   // The transformed direction of a surface normal n: the inverse transpose of m applied to n,
   // up to a positive factor (the cofactor matrix, sign-corrected by det), unit length; (0,0,0)
   // if n is zero or not finite, or the result cannot be normalised. In double, so a tiny or huge
@@ -58,9 +95,9 @@ struct Transform {
   float3 apply_normal(float3 n) const;
   // this ∘ other: first other, then this.
   Transform then(const Transform& outer) const;
-  static Transform translate(float3 d);
-  static Transform scale(float3 s);
-  static Transform rotate(float3 unit_axis, float degrees);
+  static Transform translate(double3 d);
+  static Transform scale(double3 s);
+  static Transform rotate(double3 unit_axis, double degrees);
 };
 
 // A triangle mesh in local space, before it is placed into the scene.
@@ -102,9 +139,10 @@ struct Builder {
   // Index of the material `d` of an MTL file (added on first use), unless the scene defines one
   // with the name d.name.
   int mtl_material(const std::string& mtl_file, const MaterialDesc& d);
-  // Appends a mesh to the triangle soup (transformed) and creates its mesh lights; its vertex
-  // normals become shading normals (a triangle with a zero or non-finite normal stays flat).
-  // Returns the index of its first triangle.
+  // Appends a mesh to the triangle soup (transformed in double, then rebased to the scene origin
+  // and rounded) and creates its mesh lights; its vertex normals become shading normals (a
+  // triangle with a zero or non-finite normal stays flat). Returns the index of its first
+  // triangle.
   size_t add_mesh(const Mesh& mesh, const Transform& xf);
 };
 
@@ -129,11 +167,12 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
 // `prefix` is the message start, e.g. "scene.json: " or "scene.json: shapes[0].file: a.obj: ".
 std::string read_input_file(const std::filesystem::path& file, uint64_t max_bytes,
                             const std::string& prefix);
-// Empty if every component of p is within kMaxCoordinate, else the problem (for a message).
-std::string check_coordinate(float3 p);
+// Empty if every component of p (a float coordinate as the renderer stores it) is within
+// kMaxCoordinate, else the problem (for a message), which quotes the world position p + origin.
+std::string check_coordinate(float3 p, double3 origin = {});
 // Same for the extent of a light (position, corners, or sphere bounds), "its position [...] is
 // outside ...".
-std::string check_light_extent(const Light& l);
+std::string check_light_extent(const Light& l, double3 origin);
 
 // Fails at `at` if a vertex of s.vertices[first_vertex..] is outside the coordinate range;
 // `what` starts the problem text (e.g. "instance 3: ").
@@ -143,9 +182,10 @@ void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,
 bool emits(const Light& l);
 
 // Lights (lights.cpp).
-// An analytic light from a JSON object. As a template of a light set, position-like keys are
-// offsets from the generated site and may be omitted (quad/triangle are then centred on the site).
-Light parse_light(const JsonValue& v, bool is_template);
+// An analytic light from a JSON object, its positions rebased to `origin` (the scene origin). As a
+// template of a light set, position-like keys are offsets from the generated site (`origin` is not
+// used) and may be omitted (quad/triangle are then centred on the site).
+Light parse_light(const JsonValue& v, bool is_template, double3 origin);
 // Fills n (unit normal, area in w) of a quad/triangle light; false if the area is zero.
 bool finish_area_light(Light& l);
 // Fills n (unit normal of `normal`, area in w) and the tangent frame e1, e2 of a disk light whose

@@ -60,6 +60,12 @@ public:
       : std::runtime_error(printable(message, std::string::npos)) {}
 };
 
+// A point or vector in double precision: scene coordinates before they are rebased to the scene
+// origin and rounded to float (Scene::origin).
+struct double3 {
+  double x = 0, y = 0, z = 0;
+};
+
 struct Camera {
   float3 position{0, 0, 0};
   float3 look_at{0, 0, -1};
@@ -147,6 +153,11 @@ inline MaterialDesc plastic_material(std::string name, float3 albedo, float3 spe
 // soup: the accel builder adds their primitives from `lights`.
 struct Scene {
   std::filesystem::path path; // the scene file, for messages
+  // Every float coordinate below (camera, vertices, lights, medium bounds) is relative to this
+  // point: world = coordinate + origin. load_scene sets it to the camera position and subtracts it
+  // from each input coordinate in double before rounding to float, so a scene far from (0, 0, 0)
+  // keeps its shape (docs/design.md, Robustness). Scenes built in code may leave it at 0.
+  double3 origin;
   Camera camera;
   FilmSettings film;
   IntegratorSettings integrator;

@@ -24,10 +24,7 @@ Transform Transform::then(const Transform& outer) const {
 }
 
 float3 Transform::apply_normal(float3 n) const {
-  double a[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      a[i][j] = double(m[i][j]);
+  const auto& a = m;
   // Cofactor matrix C = det(M) M^-T: normals transform by M^-T; C avoids the division, and the
   // sign of det keeps the direction (a mirror must not turn the normal inside out).
   double c[3][3];
@@ -47,13 +44,13 @@ float3 Transform::apply_normal(float3 n) const {
   return make_float3(float(r[0] / len), float(r[1] / len), float(r[2] / len));
 }
 
-Transform Transform::translate(float3 d) {
+Transform Transform::translate(double3 d) {
   Transform r;
   r.t = d;
   return r;
 }
 
-Transform Transform::scale(float3 s) {
+Transform Transform::scale(double3 s) {
   Transform r;
   r.m[0][0] = s.x;
   r.m[1][1] = s.y;
@@ -61,9 +58,9 @@ Transform Transform::scale(float3 s) {
   return r;
 }
 
-Transform Transform::rotate(float3 a, float degrees) {
-  // Rodrigues; the angle in double so 90 degrees gives exact zeros where it should.
-  double th = double(degrees) * (3.14159265358979323846 / 180.0);
+Transform Transform::rotate(double3 a, double degrees) {
+  // Rodrigues; entries below 1e-15 are zeroed so 90 degrees gives exact zeros where it should.
+  double th = degrees * (3.14159265358979323846 / 180.0);
   double c = std::cos(th), s = std::sin(th), C = 1.0 - c;
   double x = a.x, y = a.y, z = a.z;
   Transform r;
@@ -73,7 +70,7 @@ Transform Transform::rotate(float3 a, float degrees) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       double v = m[i][j];
-      r.m[i][j] = std::fabs(v) < 1e-15 ? 0.0f : float(v);
+      r.m[i][j] = std::fabs(v) < 1e-15 ? 0.0 : v;
     }
   return r;
 }
@@ -114,7 +111,7 @@ size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
   uint32_t base = uint32_t(s.vertices.size());
   reserve_more(s.vertices, mesh.vertices.size());
   for (const float3& v : mesh.vertices)
-    s.vertices.push_back(xf.apply(v));
+    s.vertices.push_back(rebase(xf.apply(v), s.origin));
   bool flip = xf.flips();
   size_t nt = mesh.triangle_count();
   reserve_more(s.indices, 3 * nt);
@@ -185,7 +182,7 @@ size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
 void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,
                     std::string_view what) {
   for (size_t i = first_vertex; i < s.vertices.size(); ++i)
-    if (auto e = check_coordinate(s.vertices[i]); !e.empty())
+    if (auto e = check_coordinate(s.vertices[i], s.origin); !e.empty())
       at.fail(fmt::format("{}vertex {} after the transform: {}", what, i - first_vertex + 1, e));
 }
 
@@ -197,16 +194,23 @@ bool emits(const Light& l) {
 
 namespace {
 
-void parse_camera(const JsonValue& v, Camera& cam) {
+// The camera position becomes the scene origin: the camera sits exactly at (0, 0, 0), where float
+// coordinates are finest.
+void parse_camera(const JsonValue& v, Camera& cam, double3& origin) {
   auto o = v.as_object();
   o.allow({"position", "look_at", "up", "fov"});
   auto pos = o.req("position");
-  cam.position = pos.as_vec3();
-  if (auto e = check_coordinate(cam.position); !e.empty()) pos.fail(e);
+  double3 p = pos.as_dvec3();
+  // The inputs stay within kMaxCoordinate too: world positions (origin + coordinate) then stay
+  // within 2 kMaxCoordinate.
+  if (auto e = check_coordinate(to_float3(p)); !e.empty()) pos.fail(e);
   auto look = o.req("look_at");
-  cam.look_at = look.as_vec3();
-  if (auto e = check_coordinate(cam.look_at); !e.empty()) look.fail(e);
-  float3 dir = cam.look_at - cam.position;
+  double3 at = look.as_dvec3();
+  if (auto e = check_coordinate(to_float3(at)); !e.empty()) look.fail(e);
+  origin = p;
+  cam.position = make_float3(0, 0, 0);
+  cam.look_at = rebase(at, origin);
+  float3 dir = cam.look_at;
   if (dir.x == 0.0f && dir.y == 0.0f && dir.z == 0.0f)
     look.fail("must differ from camera.position");
   if (!std::isfinite(dot(dir, dir))) look.fail("is too far from camera.position");
@@ -253,7 +257,7 @@ void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
 
 // The top-level "medium" (docs/scene-format.md, Participating media): homogeneous, everywhere or
 // inside a box.
-Medium parse_medium(const JsonValue& v) {
+Medium parse_medium(const JsonValue& v, double3 origin) {
   auto o = v.as_object();
   o.allow({"sigma_a", "sigma_s", "g", "bounds"});
   float3 sa = o.req("sigma_a").as_color_in(0.0f, kMaxMediumCoefficient);
@@ -268,9 +272,9 @@ Medium parse_medium(const JsonValue& v) {
     bo.allow({"min", "max"});
     auto lo = bo.req("min");
     auto hi = bo.req("max");
-    float3 mn = lo.as_vec3(), mx = hi.as_vec3();
-    if (auto e = check_coordinate(mn); !e.empty()) lo.fail(e);
-    if (auto e = check_coordinate(mx); !e.empty()) hi.fail(e);
+    float3 mn = rebase(lo.as_dvec3(), origin), mx = rebase(hi.as_dvec3(), origin);
+    if (auto e = check_coordinate(mn, origin); !e.empty()) lo.fail(e);
+    if (auto e = check_coordinate(mx, origin); !e.empty()) hi.fail(e);
     if (!(mn.x < mx.x && mn.y < mx.y && mn.z < mx.z))
       hi.fail("must exceed bounds.min in every coordinate");
     m.sigma_s.w = 1.0f;
@@ -377,11 +381,12 @@ Scene load_from_string(const std::string& json_text, const std::string& name,
   auto o = root.as_object();
   o.allow(
       {"camera", "film", "integrator", "materials", "shapes", "lights", "light_sets", "medium"});
-  parse_camera(o.req("camera"), scene.camera);
+  // First: the camera sets the origin that every later coordinate is rebased to.
+  parse_camera(o.req("camera"), scene.camera, scene.origin);
   if (auto x = o.get("film")) parse_film(*x, scene.film);
   if (auto x = o.get("integrator")) parse_integrator(*x, scene.integrator);
   if (auto x = o.get("medium")) {
-    scene.medium = parse_medium(*x);
+    scene.medium = parse_medium(*x, scene.origin);
     // A medium with sigma_t = 0 is vacuum: no medium code at all.
     scene.has_medium = max3(xyz_of(scene.medium.sigma_t)) > 0.0f;
   }
@@ -392,8 +397,8 @@ Scene load_from_string(const std::string& json_text, const std::string& name,
     scene.lights.reserve(scene.lights.size() + n);
     for (size_t i = 0; i < n; ++i) {
       JsonValue lv = x->at(i);
-      Light l = parse_light(lv, false);
-      if (auto e = check_light_extent(l); !e.empty()) lv.fail(e);
+      Light l = parse_light(lv, false, scene.origin);
+      if (auto e = check_light_extent(l, scene.origin); !e.empty()) lv.fail(e);
       // A light switched off (zero emission) is skipped: it neither emits nor occludes.
       if (emits(l))
         scene.lights.push_back(l);

@@ -21,18 +21,22 @@ Transform parse_transform(const JsonValue& v) {
       sc = s->as_vec3();
     }
     if (sc.x == 0.0f || sc.y == 0.0f || sc.z == 0.0f) s->fail("must be non-zero");
-    xf = xf.then(Transform::scale(sc));
+    xf = xf.then(Transform::scale(dvec(sc)));
   }
   if (auto r = o.get("rotate")) {
     auto ro = r->as_object();
     ro.allow({"axis", "degrees"});
-    float3 axis = ro.req("axis").as_vec3_nonzero();
-    float deg = ro.req("degrees").as_float();
-    xf = xf.then(Transform::rotate(normalize(axis), deg));
+    double3 axis = dvec(ro.req("axis").as_vec3_nonzero());
+    // Normalised in double: any non-zero float axis has a finite, non-zero length there.
+    double len = std::sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
+    xf = xf.then(Transform::rotate(axis * (1.0 / len), double(ro.req("degrees").as_float())));
   }
-  if (auto t = o.get("translate")) xf = xf.then(Transform::translate(t->as_vec3()));
-  if (!std::isfinite(xf.det())) v.fail("is too large (its determinant overflows; docs/limits.md)");
-  if (xf.det() == 0.0f) v.fail("is degenerate (zero determinant)");
+  // The translation stays in double: it is where a shape far from the origin gets its position.
+  if (auto t = o.get("translate")) xf = xf.then(Transform::translate(t->as_dvec3()));
+  // The matrix is in double, but the limits are those of float arithmetic on its entries.
+  float det = to_float(xf.det());
+  if (!std::isfinite(det)) v.fail("is too large (its determinant overflows; docs/limits.md)");
+  if (det == 0.0f) v.fail("is degenerate (zero determinant)");
   return xf;
 }
 
@@ -79,41 +83,48 @@ ShapeDesc parse_shape(const JsonValue& v, Builder& b) {
   } else if (type == "quad") {
     o.allow({"type", "name", "material", "emission", "two_sided", "transform", "corner", "edge1",
              "edge2"});
-    float3 c = o.req("corner").as_vec3();
+    // The corner goes into the (double) transform, the mesh holds the edges only: a quad far
+    // from the origin keeps its shape (Scene::origin).
+    double3 c = o.req("corner").as_dvec3();
     float3 e1 = o.req("edge1").as_vec3();
     float3 e2 = o.req("edge2").as_vec3();
     float3 n = cross(e1, e2);
     float a = length(n);
     if (!(a > 0.0f)) o.fail("area must be > 0 (edge1 and edge2 are parallel or zero)");
     if (!std::isfinite(a)) o.fail("area is too large");
-    add_quad(d.mesh, c, e1, e2, mat < 0 ? 0 : mat, em);
+    add_quad(d.mesh, make_float3(0, 0, 0), e1, e2, mat < 0 ? 0 : mat, em);
+    d.transform = Transform::translate(c).then(d.transform);
   } else { // box
     o.allow({"type", "name", "material", "emission", "two_sided", "transform", "min", "max",
              "rotate_y"});
-    float3 lo = o.req("min").as_vec3();
+    double3 lo = o.req("min").as_dvec3();
     auto maxv = o.req("max");
-    float3 hi = maxv.as_vec3();
+    double3 hi = maxv.as_dvec3();
     if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) maxv.fail("must be > min in every component");
-    float3 ctr = (lo + hi) * 0.5f;
-    float3 ext = hi - lo;
+    // The mesh is the box from its min corner, which goes into the (double) transform: a box far
+    // from the origin keeps its shape. Vertex 1 is the min corner itself, so a box beyond the
+    // coordinate range is reported there even if its extent overflows float.
+    float3 ext = to_float3(hi - lo);
     int m = mat < 0 ? 0 : mat;
     // Six faces, each oriented so cross(e1, e2) points out of the box.
+    const float3 o0 = make_float3(0, 0, 0);
     float3 X = make_float3(ext.x, 0, 0), Y = make_float3(0, ext.y, 0), Z = make_float3(0, 0, ext.z);
-    add_quad(d.mesh, lo, Z, Y, m, em);     // -x
-    add_quad(d.mesh, lo + X, Y, Z, m, em); // +x
-    add_quad(d.mesh, lo, X, Z, m, em);     // -y
-    add_quad(d.mesh, lo + Y, Z, X, m, em); // +y
-    add_quad(d.mesh, lo, Y, X, m, em);     // -z
-    add_quad(d.mesh, lo + Z, X, Y, m, em); // +z
+    add_quad(d.mesh, o0, Z, Y, m, em); // -x
+    add_quad(d.mesh, X, Y, Z, m, em);  // +x
+    add_quad(d.mesh, o0, X, Z, m, em); // -y
+    add_quad(d.mesh, Y, Z, X, m, em);  // +y
+    add_quad(d.mesh, o0, Y, X, m, em); // -z
+    add_quad(d.mesh, Z, X, Y, m, em);  // +z
+    Transform place = Transform::translate(lo);
     if (auto r = o.get("rotate_y")) {
-      float deg = r->as_float();
       // Rotation about the vertical axis through the box centre, before the transform.
-      Transform rot = Transform::translate(-ctr)
-                          .then(Transform::rotate(make_float3(0, 1, 0), deg))
-                          .then(Transform::translate(ctr));
-      for (float3& p : d.mesh.vertices)
-        p = rot.apply(p);
+      double3 h = dvec(ext) * 0.5;
+      place = Transform::translate(h * -1.0)
+                  .then(Transform::rotate(double3{0, 1, 0}, double(r->as_float())))
+                  .then(Transform::translate(h))
+                  .then(place);
     }
+    d.transform = place.then(d.transform);
   }
   return d;
 }
