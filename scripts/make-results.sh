@@ -108,6 +108,14 @@ for name in $SCENES; do
   fi
   clamp_opt=()
   if [ "$clamp" != 0 ]; then clamp_opt=(--clamp "$clamp"); fi
+  # tree-split runs at the scene's own threshold; where the scene sets another than the
+  # renderer's default (0.25), tree-split at the default is measured too.
+  samplers=$SAMPLERS
+  thr=$(grep -o '"split_threshold": *[0-9.]*' "$scene" | grep -o '[0-9.]*$' || true)
+  if [ -n "$thr" ] && [ "$thr" != 0.25 ] && [[ ",$samplers," == *",tree-split,"* ]] &&
+    [[ ",$samplers," != *",tree-split:0.25,"* ]]; then
+    samplers="$samplers,tree-split:0.25"
+  fi
   rm -f "$DOCS/$name"-d*.csv "$DOCS/$name"-d*-reference.json "$DOCS/$name"-d*-commands.txt
   full_depth=
   for depth in $DEPTHS; do
@@ -129,9 +137,9 @@ for name in $SCENES; do
       echo "== [$i/$nscenes] $name ($tag): reusing the reference $ref" >&2
     fi
     echo "== [$i/$nscenes] $name, depth $depth: film scale $scale, reference $ref_sampler ~${ref_time} s," \
-      "equal time $eqt s x $SEEDS seeds, samplers $SAMPLERS ($(elapsed) so far)" >&2
+      "equal time $eqt s x $SEEDS seeds, samplers $samplers ($(elapsed) so far)" >&2
     cmd=("$CANOPY" converge "$scene" --film-scale "$scale" "${depth_opt[@]}" "${clamp_opt[@]}"
-      --reference "$ref" "${ref_opt[@]}" --samplers "$SAMPLERS" --equal-time "$eqt"
+      --reference "$ref" "${ref_opt[@]}" --samplers "$samplers" --equal-time "$eqt"
       --seeds "$SEEDS" --out "$DOCS/$name-$tag")
     echo "${cmd[*]}" | sed "s|^$CANOPY|canopy|" >"$DOCS/$name-$tag-commands.txt"
     if [ ${#ref_opt[@]} = 0 ]; then

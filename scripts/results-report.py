@@ -155,11 +155,41 @@ def table(rows):
     return lines, m, best
 
 
+def default_section(text_path, candidates, table_names):
+    """The default estimator: the hand-written reasoning (text_path), then, generated, each
+    configuration's non-emitter efficiency relative to each table's best and whether it meets the
+    rule (best, within 10% or overlapping intervals) in every table."""
+    out = ["## The default estimator", ""]
+    if text_path and os.path.exists(text_path):
+        out += [open(text_path).read().strip(), ""]
+    out += ["Non-emitter efficiency over each table's best (1 = best; * within 10% or "
+            "overlapping intervals; u unresolved; - not run):", ""]
+    out.append("| configuration | " + " | ".join(table_names) + " | meets the rule everywhere |")
+    out.append("|---|" + "---|" * (len(table_names) + 1))
+    for label, per in candidates.items():
+        cells, every = [], True
+        for t in table_names:
+            ratio, verdict = per.get(t, (float("nan"), "-"))
+            if verdict == "unresolved":
+                cells.append("u")
+            elif not math.isfinite(ratio):
+                cells.append("-")
+                every = False
+            else:
+                ok = verdict in ("best", "within 10%", "overlaps")
+                every = every and ok
+                cells.append(f"{ratio:.2f}" + ("*" if ok and verdict != "best" else ""))
+        out.append(f"| {label} | " + " | ".join(cells) + f" | {'yes' if every else 'no'} |")
+    return out + [""]
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--docs", default="docs/results")
     ap.add_argument("--command", default="./scripts/make-results.sh")
     ap.add_argument("--note", default="", help="a line on the run (scenes, budgets, seeds)")
+    ap.add_argument("--default-text", default="scripts/results-default.md",
+                    help="the reasoning behind the default estimator (Markdown), quoted as is")
     args = ap.parse_args()
     docs_rel = os.path.relpath(args.docs, "docs") if not os.path.isabs(args.docs) else args.docs
 
@@ -196,6 +226,10 @@ def main():
 
     summary = ["| scene | table | best (non-emitter efficiency) | within 10% or overlapping | "
                "unresolved |", "|---|---|---|---|---|"]
+    # Per configuration, per table: its non-emitter efficiency over the best's and its verdict
+    # (the choice of the default: within 10% of the best, or overlapping, in every table).
+    candidates = {}  # label -> {table: (ratio, verdict)}
+    table_names = []
     sections = []
     for name, desc in SCENES:
         tables = []
@@ -207,14 +241,14 @@ def main():
             lines, m, best = table(rows)
             cmd_path = os.path.join(args.docs, f"{name}-{tag}-commands.txt")
             cmd = open(cmd_path).read().strip() if os.path.exists(cmd_path) else ""
-            tables.append((tag, title, depth, lines, m, best, cmd))
+            tables.append((tag, title, depth, lines, m, best, cmd, rows))
         if not tables:
             continue
         sec = [f"## {name}", "", desc + ".", ""]
         if os.path.exists(os.path.join(args.docs, f"{name}.png")):
             sec += [f"![{name}]({docs_rel}/{name}.png) ![{name}: emitter pixels]"
                     f"({docs_rel}/{name}-mask.png)", ""]
-        for tag, title, depth, lines, m, best, cmd in tables:
+        for tag, title, depth, lines, m, best, cmd, rows in tables:
             t = title if tag == "d1" else f"Full paths (the scene's depth, {depth})"
             if tag == "dfull" and depth == "1":
                 t = "Direct light (the scene's depth is 1: one table)"
@@ -224,11 +258,20 @@ def main():
             sec += lines + [""]
             close = [k for k, v in m.items() if v in ("within 10%", "overlaps")]
             unres = [k for k, v in m.items() if v == "unresolved"]
+            tname = f"{name} {'d1' if tag == 'd1' else 'd' + depth}"
+            table_names.append(tname)
+            for r in rows:
+                ratio = (num(r, "efficiency_ne") / num(best, "efficiency_ne")
+                         if best and usable(r) else float("nan"))
+                candidates.setdefault(r["sampler"], {})[tname] = (ratio, m.get(r["sampler"], ""))
             summary.append(f"| {name} | {'depth 1' if tag == 'd1' else 'depth ' + depth} | "
                            f"{best['sampler'] if best else 'none resolved'} | "
                            f"{', '.join(close) or '-'} | {', '.join(unres) or '-'} |")
         sections += sec
-    out += ["## Summary", ""] + summary + [""] + sections
+    out += ["## Summary", ""] + summary + [""]
+    if table_names:
+        out += default_section(args.default_text, candidates, table_names)
+    out += sections
     print("\n".join(out))
 
 
