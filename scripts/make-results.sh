@@ -2,7 +2,7 @@
 # Regenerates docs/results.md and docs/results/ from scratch: builds canopy, and per scene of the
 # table below, at two path depths (direct light, `--max-depth 1`, and the scene's own depth),
 # renders a reference and runs `canopy converge --equal-time` for every sampler configuration;
-# then writes the report (scripts/results-report.py). About 60-70 minutes on 2 cores (the
+# then writes the report (scripts/results-report.py). About 50 minutes on 2 cores (the
 # estimate per scene is in the table's comment); not run by CI. Timings are only meaningful on an
 # otherwise idle machine.
 #
@@ -67,25 +67,25 @@ SAMPLERS=${SAMPLERS:-power,tree,tree-split,brdf-mis,bsdf}
 # seconds (per depth). Films are scaled (--film-scale) so that a render of T seconds holds a few
 # spp or more: the metrics are per pixel. Per scene and depth the run costs about
 #   5 configurations x (build + kernel compile + warm-up, ~2-4 s; timing renders ~0.75 T; SEEDS T)
-#   + reference (warm-up + timing + R)  ~  5 x 13 s + 85 s  ~  2.5 min at T = 1 s, R = 80 s,
-# so ~5 min per scene (both depths; plane-10k and mesh-light have depth 1 only), ~55 min for
-# the 11 scenes, plus scene loading and light tree builds (cornell-1m, city: a few s per
-# configuration).
+#   + reference (warm-up + timing + R)  ~  5 x 13 s + 65 s  ~  2.3 min at T = 1 s, R = 60 s,
+# so ~5 min per scene (both depths; plane-10k and mesh-light have depth 1 only): the 11 scenes
+# took 47 minutes (2026-11-25, 5-7 configurations), scene loading and light tree builds
+# included. R = 60 s keeps every reference's non-emitter floor >= 10x below the judged MSEs.
 # clamp: 0 = none (the non-emitter metrics leave out directly visible emitters, so no scene needs
 # a clamp; a clamp biases heavy-tailed estimators).
 # name           | film scale | T (s) | reference      | R (s) | clamp
 SCENE_TABLE="
-default        | 0.5  | 1 | tree-split:0.5 | 80 | 0
-glossy-cornell | 1    | 1 | tree-split:0.5 | 80 | 0
-showroom       | 1    | 1 | tree-split:0.5 | 80 | 0
-cornell-1k     | 1    | 1 | tree-split:0.5 | 80 | 0
-cornell-1m     | 1    | 1 | tree-split:0.5 | 80 | 0
-plane-10k      | 1    | 1 | tree-split:0.5 | 80 | 0
-spiral-10k     | 0.25 | 1 | tree-split:0.5 | 80 | 0
-city           | 0.5  | 1 | tree-split:0.5 | 80 | 0
-mesh-light     | 0.5  | 1 | tree-split:0.5 | 80 | 0
-spiral-fog     | 0.5  | 1 | tree-split:0.5 | 80 | 0
-city-fog       | 0.25 | 1 | tree-split:0.5 | 80 | 0
+default        | 0.5  | 1 | tree-split:0.5 | 60 | 0
+glossy-cornell | 1    | 1 | tree-split:0.5 | 60 | 0
+showroom       | 1    | 1 | tree-split:0.5 | 60 | 0
+cornell-1k     | 1    | 1 | tree-split:0.5 | 60 | 0
+cornell-1m     | 1    | 1 | tree-split:0.5 | 60 | 0
+plane-10k      | 1    | 1 | tree-split:0.5 | 60 | 0
+spiral-10k     | 0.25 | 1 | tree-split:0.5 | 60 | 0
+city           | 0.5  | 1 | tree-split:0.5 | 60 | 0
+mesh-light     | 0.5  | 1 | tree-split:0.5 | 60 | 0
+spiral-fog     | 0.5  | 1 | tree-split:0.5 | 60 | 0
+city-fog       | 0.25 | 1 | tree-split:0.5 | 60 | 0
 "
 ALL_SCENES="default glossy-cornell showroom cornell-1k cornell-1m plane-10k spiral-10k city mesh-light spiral-fog city-fog"
 SCENES=${SCENES:-$ALL_SCENES}
@@ -108,13 +108,17 @@ for name in $SCENES; do
   fi
   clamp_opt=()
   if [ "$clamp" != 0 ]; then clamp_opt=(--clamp "$clamp"); fi
-  # tree-split runs at the scene's own threshold; where the scene sets another than the
-  # renderer's default (0.25), tree-split at the default is measured too.
+  # tree-split (and brdf-mis' tree-split part) runs at the scene's own threshold; where the scene
+  # sets another than the renderer's default (0.25), they are measured at the default too.
   samplers=$SAMPLERS
   thr=$(grep -o '"split_threshold": *[0-9.]*' "$scene" | grep -o '[0-9.]*$' || true)
   if [ -n "$thr" ] && [ "$thr" != 0.25 ] && [[ ",$samplers," == *",tree-split,"* ]] &&
     [[ ",$samplers," != *",tree-split:0.25,"* ]]; then
     samplers="$samplers,tree-split:0.25"
+  fi
+  if [ -n "$thr" ] && [ "$thr" != 0.25 ] && [[ ",$samplers," == *",brdf-mis,"* ]] &&
+    [[ ",$samplers," != *",brdf-mis/split=0.25,"* ]]; then
+    samplers="$samplers,brdf-mis/split=0.25"
   fi
   rm -f "$DOCS/$name"-d*.csv "$DOCS/$name"-d*-reference.json "$DOCS/$name"-d*-commands.txt
   full_depth=

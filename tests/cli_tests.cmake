@@ -112,15 +112,15 @@ canopy_cli_test(cli_spp_above_a_million
 canopy_cli_test(cli_spp_above_format_limit -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
   "-DARGS=--spp|16777217" "-DEXPECT=--spp: must be in [1, 16777216], got 16777217"
   -P ${CANOPY_CHECK2})
-# Issue 10: a scene without sampler settings renders with tree-split at the measured default
-# threshold and pbrt-v4's default depth, and the summary line says so; --max-cut and --max-depth
-# override the scene and are range-checked.
+# Issues 10 and 20: a scene without sampler settings renders with the measured default (brdf-mis,
+# its tree-split part at the measured default threshold) and pbrt-v4's default depth, and the
+# summary line says so; --max-cut and --max-depth override the scene and are range-checked.
 canopy_cli_test(cli_default_sampler_summary
   "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--out|${CANOPY_SCRATCH}/defaults.exr"
-  "-DSTDERR=1 spp, sampler tree-split (threshold 0.25, max cut 64), max depth 5, 1 lights"
+  "-DSTDERR=1 spp, sampler brdf-mis (threshold 0.25, max cut 64, delta 0.5, N_max 50, lambda 10), max depth 5, 1 lights"
   -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_max_cut_option
-  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--max-cut|3|--max-depth|2|--out|${CANOPY_SCRATCH}/max_cut.exr"
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--light-sampler|tree-split|--max-cut|3|--max-depth|2|--out|${CANOPY_SCRATCH}/max_cut.exr"
   "-DSTDERR=sampler tree-split (threshold 0.25, max cut 3), max depth 2" -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_max_cut_zero -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
   "-DARGS=--max-cut|0" "-DEXPECT=--max-cut: must be in [1, 65536], got 0" -P ${CANOPY_CHECK2})
@@ -131,11 +131,17 @@ canopy_cli_test(cli_max_depth_too_large -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
 # --samplers` takes a trailing /nomis (tests/cli_tools.cmake checks that it renders with MIS off),
 # refuses any other suffix and refuses /nomis on bsdf (BSDF sampling only), before rendering.
 canopy_cli_test(cli_render_no_mis
-  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--no-mis|--out|${CANOPY_SCRATCH}/no_mis.exr"
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--light-sampler|tree-split|--no-mis|--out|${CANOPY_SCRATCH}/no_mis.exr"
   "-DSTDERR=sampler tree-split (threshold 0.25, max cut 64, no MIS)" -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_converge_bad_mis_suffix
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|power,tree-split:0.5/mis"
   -DRC=2 "-DSTDERR=--samplers: 'tree-split:0.5/mis': unknown or repeated suffix '/mis' (/nomis: MIS off; /equal: brdf-mis with equal allocation)"
+  -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
+# Issue 20: "/split=T" sets the split threshold where ":T" is brdf-mis' delta; out of range is
+# refused before rendering.
+canopy_cli_test(cli_converge_bad_split_suffix
+  "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|brdf-mis/split=2"
+  -DRC=2 "-DSTDERR=--samplers: 'brdf-mis/split=2': /split=T: T must be a number in [0, 1]"
   -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_converge_bsdf_nomis
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|bsdf/nomis"

@@ -51,7 +51,7 @@ TEST(SceneLoader, CameraFilmIntegrator) {
   EXPECT_EQ(s.film.height, 200);
   EXPECT_EQ(s.integrator.spp, 7);
   EXPECT_EQ(s.integrator.max_depth, 4);
-  EXPECT_EQ(s.integrator.light_sampler, "tree-split");
+  EXPECT_EQ(s.integrator.light_sampler, "brdf-mis");
   EXPECT_FLOAT_EQ(s.integrator.split_threshold, 0.5f);
   EXPECT_EQ(s.integrator.max_cut, 9);
   EXPECT_EQ(s.integrator.seed, 4294967295u);
@@ -66,9 +66,10 @@ TEST(SceneLoader, Defaults) {
   EXPECT_EQ(s.film.width, 640);
   EXPECT_EQ(s.film.height, 480);
   EXPECT_EQ(s.integrator.spp, 16);
-  // Without sampler settings the renderer shows its best: tree-split at the measured threshold.
+  // Without sampler settings the renderer shows its best: brdf-mis (tree-split at the measured
+  // threshold at diffuse points), the best worst case of docs/results.md.
   EXPECT_EQ(s.integrator.max_depth, 5);
-  EXPECT_EQ(s.integrator.light_sampler, "tree-split");
+  EXPECT_EQ(s.integrator.light_sampler, "brdf-mis");
   EXPECT_FLOAT_EQ(s.integrator.split_threshold, LT_DEFAULT_SPLIT_THRESHOLD);
   EXPECT_EQ(s.integrator.max_cut, 64);
   EXPECT_EQ(s.integrator.seed, 1u);

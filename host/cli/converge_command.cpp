@@ -72,6 +72,7 @@ constexpr std::string_view kNoOrientSuffix = "-noorient";
 constexpr std::string_view kNoMisSuffix = "nomis";       // after a '/'
 constexpr std::string_view kEqualSuffix = "equal";       // after a '/'
 constexpr std::string_view kMidpointSuffix = "midpoint"; // after a '/'
+constexpr std::string_view kSplitSuffix = "split=";      // after a '/', then the threshold
 constexpr float kMaxBrdfDelta = 1000.0f;                 // as `canopy render --brdf-delta`
 
 bool is_brdf_sampler(const std::string& sampler) {
@@ -141,7 +142,7 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
   c.brdf.lambda = scene.brdf_lambda;
   c.brdf.adaptive = true;
   std::string spec = text;
-  bool equal = false;
+  bool equal = false, split_set = false;
   if (size_t slash = spec.find('/'); slash != std::string::npos) {
     std::stringstream suffixes(spec.substr(slash + 1));
     spec.resize(slash);
@@ -155,12 +156,23 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
         equal = true;
       } else if (suffix == kMidpointSuffix && !c.volume_midpoint) {
         c.volume_midpoint = true;
+      } else if (suffix.starts_with(kSplitSuffix) && !split_set) {
+        // "/split=T": tree-split's threshold T where ":T" means something else (brdf-mis'
+        // delta), e.g. brdf-mis/split=0.25 at the renderer's default threshold.
+        std::string t = suffix.substr(kSplitSuffix.size());
+        char* end = nullptr;
+        double v = std::strtod(t.c_str(), &end);
+        if (t.empty() || *end != '\0' || !(v >= 0.0 && v <= 1.0))
+          throw SceneError(fmt::format("{}: '{}': /{}T: T must be a number in [0, 1]", option,
+                                       printable(text, 256), kSplitSuffix));
+        c.threshold = float(v);
+        split_set = true;
       } else {
         throw SceneError(fmt::format("{}: '{}': unknown or repeated suffix '/{}' (/{}: MIS off; "
                                      "/{}: brdf-mis with equal allocation; /{}: medium segments "
-                                     "ranked at their midpoint)",
+                                     "ranked at their midpoint; /{}T: split threshold T)",
                                      option, printable(text, 256), printable(suffix, 256),
-                                     kNoMisSuffix, kEqualSuffix, kMidpointSuffix));
+                                     kNoMisSuffix, kEqualSuffix, kMidpointSuffix, kSplitSuffix));
       }
     }
     if (!any)

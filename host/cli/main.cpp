@@ -152,7 +152,8 @@ void check_writable(const fs::path& file, const char* option) {
 std::string sampler_summary(const IntegratorSettings& in, bool orientation_term) {
   std::string s = "sampler " + in.light_sampler;
   std::vector<std::string> parts;
-  if (in.light_sampler == "tree-split") {
+  if (in.light_sampler == "tree-split" || in.light_sampler == "brdf-mis" ||
+      in.light_sampler == "brdf-oriented") { // (the BRDF samplers are tree-split at diffuse points)
     parts.push_back(fmt::format("threshold {}", in.split_threshold));
     parts.push_back(fmt::format("max cut {}", in.max_cut));
   }

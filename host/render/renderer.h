@@ -94,7 +94,9 @@ struct RenderSettings {
 };
 
 struct RendererOptions {
-  std::string light_sampler = "tree-split"; // uniform | power | tree | tree-split | exhaustive
+  // The library's baseline for code that builds a renderer directly (the tests); the product's
+  // default is the scene's (IntegratorSettings::light_sampler, brdf-mis: docs/results.md).
+  std::string light_sampler = "tree-split"; // a name of kLightSamplerNames
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD;
   int max_cut = kDefaultMaxCut;       // cut size cap per shading point (tree-split)
   bool orientation_term = true;       // tree samplers: false = E / d^2 importance (ablation)

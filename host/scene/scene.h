@@ -78,12 +78,14 @@ struct FilmSettings {
   int height = 480; // pixels, 1 .. kMaxFilmSide
 };
 
-// Defaults show the renderer at its best: the light tree with adaptive splitting at the threshold
-// docs/results.md measures best, and paths of pbrt-v4's default depth.
+// Defaults show the renderer at its best: the estimator with the best worst case over the
+// shipped scenes in docs/results.md ("The default estimator": Liu et al.'s BRDF-oriented MIS at
+// glossy points, the light tree with adaptive splitting at the measured threshold elsewhere), and
+// paths of pbrt-v4's default depth.
 struct IntegratorSettings {
   int spp = 16;      // samples per pixel, 1 .. kMaxSpp
-  int max_depth = 5; // path vertices after the camera hit: 1 = direct light only
-  std::string light_sampler = "tree-split";           // a name of kLightSamplerNames
+  int max_depth = 5; // path vertices that sample lights (pbrt-v4's maxdepth): 1 = direct light
+  std::string light_sampler = "brdf-mis";             // a name of kLightSamplerNames
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD; // adaptive splitting threshold in [0, 1]
   int max_cut = kDefaultMaxCut; // tree-split: at most this many lights per shading point
   uint32_t seed = 1;
