@@ -51,7 +51,7 @@ TEST(SceneLoader, CameraFilmIntegrator) {
   EXPECT_EQ(s.film.height, 200);
   EXPECT_EQ(s.integrator.spp, 7);
   EXPECT_EQ(s.integrator.max_depth, 4);
-  EXPECT_EQ(s.integrator.light_sampler, "brdf-mis");
+  EXPECT_EQ(s.integrator.light_sampler, "tree-split");
   EXPECT_FLOAT_EQ(s.integrator.split_threshold, 0.5f);
   EXPECT_EQ(s.integrator.max_cut, 9);
   EXPECT_EQ(s.integrator.seed, 4294967295u);
