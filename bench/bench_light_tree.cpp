@@ -16,8 +16,8 @@
 // sampler: 0 uniform, 1 power, 2 tree (random points layout).
 // layout: 0 random points, 1 randomly oriented triangles, 2 city-like layout.
 #include "cl/runtime.h"
-#include "lighttree/light_sampler.h"
-#include "lighttree/synthetic_lights.h"
+#include "light_tree/light_sampler.h"
+#include "light_tree/synthetic_lights.h"
 #include "render/device_scene.h"
 #include "render/light_sampler_data.h"
 

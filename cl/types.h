@@ -28,7 +28,7 @@ typedef struct Light {
   float4 e1;
   // quad: edge 2; triangle: v2 - v0; spot: 1 - cos of the cone half-angle (x) and of the
   // falloff-start half-angle (y), both from 2 sin^2(angle / 2) in double (the falloff works in
-  // 1 - cos, exact for narrow cones, cl/light_sample.h); cos of the falloff start (w). disk: unit
+  // 1 - cos, exact for narrow cones, cl/lights/light_sample.h); cos of the falloff start (w). disk: unit
   // tangent t2 = n x t1 (xyz), w unused.
   float4 e2;
   float4 n;        // quad/triangle/disk: unit normal of the emitting face (xyz), area (w)

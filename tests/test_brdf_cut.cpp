@@ -8,7 +8,7 @@
 #include "test_light_tree_util.h"
 
 #include "light_tree/brdf_cut.h"
-#include "lighttree/light_tree.h"
+#include "light_tree/light_tree.h"
 
 #include "support/glossy_points.h"
 

@@ -5,8 +5,8 @@
 // leaving a disk or ending at a sampled point of it.
 #include "accel/bvh.h"
 #include "geometry.h"
-#include "light_sample.h"
-#include "lighttree/synthetic_lights.h"
+#include "light_tree/synthetic_lights.h"
+#include "lights/light_sample.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include "cl/kernel_args.h"
 #include "cl/runtime.h"
 #include "geometry.h"
-#include "lighttree/synthetic_lights.h"
+#include "light_tree/synthetic_lights.h"
 #include "support/closest_hit_kernel.h"
 #include "support/procedural_mesh.h"
 

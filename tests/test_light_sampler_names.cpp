@@ -1,8 +1,8 @@
 // The one list of light-sampler names (kLightSamplerNames, indexed by SAMPLER_*): every mapping
 // (scene format, CLI, host samplers, make_light_sampler_data) derives from it; and the "bsdf"
 // sampler (SAMPLER_BSDF: BSDF sampling only) picks nothing, reports pmf 0 and builds no tree.
-#include "lighttree/light_sampler.h"
-#include "lighttree/synthetic_lights.h"
+#include "light_tree/light_sampler.h"
+#include "light_tree/synthetic_lights.h"
 #include "render/features.h"
 #include "render/light_sampler_data.h"
 

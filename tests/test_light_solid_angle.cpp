@@ -3,7 +3,7 @@
 // light, the irradiance estimator matches Lambert's closed form for polygons (also 1e-6 above the
 // light, where area sampling fails), and sampled directions are uniform in solid angle
 // (chi-square against the exact solid angle of each bin).
-#include "light_sample.h"
+#include "lights/light_sample.h"
 
 #include "support/double3.h"
 

@@ -1,8 +1,8 @@
 // Helpers shared by the light-tree tests.
 #pragma once
 
-#include "lighttree/light_sampler.h"
-#include "lighttree/synthetic_lights.h"
+#include "light_tree/light_sampler.h"
+#include "light_tree/synthetic_lights.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // Kernels compiled for the scene (DESIGN §7) render exactly what kernels with every feature
 // compiled in render, and a render is bit-identical from run to run and for any wave size.
-#include "lighttree/synthetic_lights.h"
+#include "light_tree/synthetic_lights.h"
 #include "render/renderer.h"
 
 #include <gtest/gtest.h>

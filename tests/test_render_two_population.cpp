@@ -6,7 +6,7 @@
 // integrated over an area is I times that area's solid angle: cos(theta) dA / d^2 = dOmega). The
 // image mean must be within 3 standard errors (from the per-pixel sample variances) of it.
 #include "geometry.h"
-#include "lighttree/synthetic_lights.h"
+#include "light_tree/synthetic_lights.h"
 #include "render/camera.h"
 #include "render/renderer.h"
 

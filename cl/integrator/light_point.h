@@ -5,7 +5,7 @@
 #define CANOPY_INTEGRATOR_LIGHT_POINT_H
 
 #include "../bsdf/bsdf.h"
-#include "../light_sample.h"
+#include "../lights/light_sample.h"
 #include "../shading.h"
 #include "light_sampler.h"
 #include "path_state.h"

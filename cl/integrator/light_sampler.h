@@ -44,9 +44,9 @@ INLINE SplitItem light_sampler_root(const LightSamplerCtx* ls, int path) {
 
 // Picks one light among all of them (uniform, power) or below `code` (tree) for query q (a
 // shading point or a ray segment in a medium, cl/light_tree/query.h) with random words from rng,
-// each choice with exactly the probability it reports (cl/light_tree/rng.h, "exact discrete
+// each choice with exactly the probability it reports (cl/light_tree/discrete.h, "exact discrete
 // choices"). Returns the light or -1; *pmf its probability. uniform and power ignore q. The host
-// samplers (host/lighttree/light_sampler.cpp) run the same functions.
+// samplers (host/light_tree/light_sampler.cpp) run the same functions.
 INLINE int light_sampler_pick_q(const LightSamplerCtx* ls, int code, const LtQuery* q, LtRng* rng,
                                 float* pmf) {
   *pmf = 0.0f;

@@ -19,7 +19,7 @@
 
 #include "../bsdf/bsdf.h"
 #include "../geometry.h"
-#include "../light_sample.h"
+#include "../lights/light_sample.h"
 #include "../rng.h"
 #include "../shading.h"
 #include "brdf_mis.h"

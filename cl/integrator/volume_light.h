@@ -19,7 +19,7 @@
 #ifndef CANOPY_INTEGRATOR_VOLUME_LIGHT_H
 #define CANOPY_INTEGRATOR_VOLUME_LIGHT_H
 
-#include "../light_sample.h"
+#include "../lights/light_sample.h"
 #include "../shading.h"
 #include "../volume/equiangular.h"
 #include "../volume/medium.h"

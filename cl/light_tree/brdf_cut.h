@@ -11,7 +11,7 @@
 #include "../compat.h"
 #include "importance.h"
 #include "layout.h"
-#include "rng.h"
+#include "discrete.h"
 
 // Capacity of a point's cut. The paper's cuts average 3.4 (delta 0.5) to 51 (delta 0.005) clusters
 // (Table 2); a cut that would grow past this stops splitting (it still covers every light, so the

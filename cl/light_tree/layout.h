@@ -1,7 +1,7 @@
 // The light tree's device layout (Conty Estevez & Kulla 2018, §4.1-4.2: a BVH of lights whose nodes
 // hold bounding spheres, orientation cones and energies), the view LtTree the samplers read it
 // through, leaf codes, emitter records and the octahedral decoding of cone axes. The build is
-// host/lighttree/light_tree.cpp; importance.h, traverse.h, split.h and pmf.h read it. Compiles as
+// host/light_tree/light_tree.cpp; importance.h, traverse.h, split.h and pmf.h read it. Compiles as
 // OpenCL C and as C++ (cl/compat.h).
 //
 // The tree is 4-wide. Node `n` owns LT_NODE_F4 (8) consecutive float4 in `nodes` (struct of

@@ -9,7 +9,7 @@
 #include "importance.h"
 #include "layout.h"
 #include "query.h"
-#include "rng.h"
+#include "discrete.h"
 #include "split.h"
 
 // Probability that lt_pick_below_q(code, q) returns the light whose remaining trail (decision at

@@ -8,7 +8,7 @@
 #include "importance.h"
 #include "layout.h"
 #include "query.h"
-#include "rng.h"
+#include "discrete.h"
 
 // Prefetches the records of the children of a node that the next step may read: node records
 // and child codes of its child nodes, emitter records of its leaves.

@@ -1,6 +1,6 @@
 #include "render/light_sampler_data.h"
 
-#include "lighttree/light_sampler.h"
+#include "light_tree/light_sampler.h"
 #include "render/features.h"
 
 #include <algorithm>

@@ -5,7 +5,7 @@
 
 #include "integrator/light_sampler.h"
 #include "light_tree/brdf_cut.h"
-#include "lighttree/light_tree.h"
+#include "light_tree/light_tree.h"
 
 #include <string>
 #include <vector>

@@ -7,7 +7,7 @@
 #include "accel/bvh.h"
 #include "cl/runtime.h"
 #include "image/image_io.h"
-#include "lighttree/light_tree.h"
+#include "light_tree/light_tree.h"
 #include "render/device_scene.h"
 #include "render/features.h"
 #include "render/light_sampler_data.h"

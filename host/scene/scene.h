@@ -4,7 +4,7 @@
 #pragma once
 
 #include "light_tree/split.h"              // cl/: LT_DEFAULT_SPLIT_THRESHOLD
-#include "lighttree/light_sampler_names.h" // kLightSamplerNames
+#include "light_tree/light_sampler_names.h" // kLightSamplerNames
 #include "types.h"                         // cl/types.h: Light, Material (device layouts)
 
 #include <array>

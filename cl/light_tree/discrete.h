@@ -1,10 +1,10 @@
-// Random numbers of the light samplers and every discrete choice they make, exactly: the
-// counter-based stream LtRng, a uniform index, the alias method, and the choice of one of four
+// Every discrete choice of the light samplers, made exactly from the counter-based stream LtRng
+// (cl/rng.h): a uniform index, the alias method, and the choice of one of four
 // lanes (the light-tree descent of Conty Estevez & Kulla 2018, Alg. 2, picks a child with
 // probability proportional to its importance, Eq. 3) with the probability lt_lane_prob reports.
 // Compiles as OpenCL C and as C++ (cl/compat.h): host and device make the same decisions.
-#ifndef CANOPY_LIGHT_TREE_RNG_H
-#define CANOPY_LIGHT_TREE_RNG_H
+#ifndef CANOPY_LIGHT_TREE_DISCRETE_H
+#define CANOPY_LIGHT_TREE_DISCRETE_H
 
 #include "../compat.h"
 #include "../rng.h"
@@ -15,31 +15,6 @@
 // 2^32 as a float (exact): scales a probability to the units of one 32-bit random word.
 #define LT_TWO_POW_32 4294967296.0f
 #define LT_TWO_POW_24 16777216.0f
-
-// ---------------------------------------------------------------- random numbers
-// A counter-based stream: value i of stream (seed, stream) is a hash of (key, i). Cheap to carry
-// in a kernel's private memory; the host sampler interface uses the same struct.
-typedef struct LtRng {
-  uint key;
-  uint ctr;
-} LtRng;
-
-// Counter-based stream keyed by hash_u32 (cl/rng.h: the "lowbias32" finaliser).
-INLINE LtRng lt_rng_make(uint seed, uint stream) {
-  LtRng r;
-  r.key = hash_u32(hash_u32(seed ^ 0x3c6ef372u) ^ (stream * 0x9e3779b9u + 0x7f4a7c15u));
-  r.ctr = 0u;
-  return r;
-}
-INLINE uint lt_rng_next_u32(LtRng* r) {
-  uint x = hash_u32(hash_u32(r->ctr * 0x9e3779b9u + r->key) ^ r->key);
-  r->ctr += 1u;
-  return x;
-}
-// Uniform in [0, 1) with 24 random bits.
-INLINE float lt_rng_next(LtRng* r) {
-  return (float)(lt_rng_next_u32(r) >> 8) * LT_XI_RES0;
-}
 
 // ---------------------------------------------------------------- exact discrete choices
 // Every discrete choice (uniform index, alias slot and test, tree lane) is made from 32-bit
@@ -176,4 +151,4 @@ LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
   return pos == 0 ? i0 : (pos == 1 ? i1 : (pos == 2 ? i2 : i3));
 }
 
-#endif // CANOPY_LIGHT_TREE_RNG_H
+#endif // CANOPY_LIGHT_TREE_DISCRETE_H

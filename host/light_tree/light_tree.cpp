@@ -1,4 +1,4 @@
-#include "lighttree/light_tree.h"
+#include "light_tree/light_tree.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -538,14 +538,14 @@ float BinaryLightNode::cv2() const {
 
 namespace {
 // EmitterBounds::plane_h. The renderer's emission test is dot(L.n, P - x) > 0 for the sampled or
-// hit point x (cl/light_sample.h), so the emitter sends nothing to P if dot(n, P) <= min over its
-// vertices of dot(n, x) (a linear function is smallest at a vertex of the polygon). The margin,
-// 2^-20 (|p| + |e1| + |e2|) in the 1-norm, covers the rounding of the sample points (gamma(6) of
-// the same sum, cl/light_sample.h), of the geometry triangles' vertices, of n's normalisation
-// (L.n's direction to ~1e-7 times the emitter's radius) and of this double evaluation.
-// A one-sided disk emits towards P iff dot(n, P - centre) > 0 (cl/light_sample.h tests the centre,
-// whatever the sampled or hit point), so h is dot(n, c - centre) plus the same margin, with
-// |centre| + 2r per axis in place of |p| + |e1| + |e2|.
+// hit point x (cl/lights/light_sample.h), so the emitter sends nothing to P if dot(n, P) <= min
+// over its vertices of dot(n, x) (a linear function is smallest at a vertex of the polygon). The
+// margin, 2^-20 (|p| + |e1| + |e2|) in the 1-norm, covers the rounding of the sample points
+// (gamma(6) of the same sum, cl/lights/light_sample.h), of the geometry triangles' vertices, of n's
+// normalisation (L.n's direction to ~1e-7 times the emitter's radius) and of this double
+// evaluation. A one-sided disk emits towards P iff dot(n, P - centre) > 0 (cl/lights/light_sample.h
+// tests the centre, whatever the sampled or hit point), so h is dot(n, c - centre) plus the same
+// margin, with |centre| + 2r per axis in place of |p| + |e1| + |e2|.
 double disk_plane_offset(const Light& l, const EmitterBounds& b) {
   const float3 n = b.cone.axis;
   const float4 c = lt_sphere_of_box(b.bmin, b.bmax);

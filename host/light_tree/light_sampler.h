@@ -11,12 +11,12 @@
 // behind the shading point's horizon or outside their emission cone: zero contribution).
 #pragma once
 
+#include "light_tree/light_sampler_names.h"
+#include "light_tree/light_tree.h"
 #include "light_tree/pmf.h"      // cl/
 #include "light_tree/query.h"    // cl/
 #include "light_tree/split.h"    // cl/
 #include "light_tree/traverse.h" // cl/
-#include "lighttree/light_sampler_names.h"
-#include "lighttree/light_tree.h"
 
 #include <cstdint>
 #include <memory>
@@ -25,7 +25,7 @@
 
 namespace canopy {
 
-// Counter-based random stream (cl/light_tree/rng.h), the same struct in kernels.
+// Counter-based random stream (cl/rng.h), the same struct in kernels.
 using Rng = LtRng;
 inline Rng make_rng(uint32_t seed, uint32_t stream) {
   return lt_rng_make(seed, stream);
@@ -71,7 +71,7 @@ protected:
 };
 
 // Vose alias table over non-negative weights (built in double); all-zero (or empty) weights give a
-// uniform table. Sampling runs lt_alias_pick (cl/light_tree/rng.h), the device's function.
+// uniform table. Sampling runs lt_alias_pick (cl/light_tree/discrete.h), the device's function.
 class AliasTable {
 public:
   AliasTable() = default;
@@ -109,7 +109,7 @@ void sample_tree_split(const LtTree& t, float3 P, float3 N, Rng& rng, float thre
 std::unique_ptr<LightSampler> make_light_sampler(const std::string& name,
                                                  const std::vector<Light>& lights,
                                                  const LightSamplerOptions& opt = {});
-// kLightSamplerNames (lighttree/light_sampler_names.h), in SAMPLER_* order.
+// kLightSamplerNames (light_tree/light_sampler_names.h), in SAMPLER_* order.
 const std::vector<std::string>& light_sampler_names();
 
 } // namespace canopy

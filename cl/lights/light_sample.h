@@ -3,12 +3,12 @@
 #ifndef CANOPY_CL_LIGHT_SAMPLE_H
 #define CANOPY_CL_LIGHT_SAMPLE_H
 
-#include "compat.h"
-#include "kernel_features.h"
-#include "shading.h"
-#include "types.h"
+#include "../compat.h"
+#include "../kernel_features.h"
+#include "../shading.h"
+#include "../types.h"
 #if HAS_LIGHT_QUAD || HAS_LIGHT_TRIANGLE
-#include "lights/planar_solid_angle.h"
+#include "planar_solid_angle.h"
 #endif
 
 typedef struct LightSample {

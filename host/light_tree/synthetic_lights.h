@@ -2,8 +2,8 @@
 // every platform: they use the counter-based LtRng, not <random> distributions).
 #pragma once
 
-#include "light_tree/rng.h" // cl/: LtRng
-#include "types.h"          // cl/types.h: Light
+#include "rng.h"   // cl/: LtRng
+#include "types.h" // cl/types.h: Light
 
 #include <cstdint>
 #include <vector>

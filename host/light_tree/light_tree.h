@@ -18,9 +18,9 @@
 // The traversal reads only nodes and children (and the Light record of the light it returns).
 #pragma once
 
-#include "light_bounds.h"      // cl/: lt_light_bounds, lt_sphere_of_box
-#include "light_tree/cone.h"   // cl/: LtCone
-#include "light_tree/layout.h" // cl/: LtTree, layout constants
+#include "light_tree/cone.h"     // cl/: LtCone
+#include "light_tree/layout.h"   // cl/: LtTree, layout constants
+#include "lights/light_bounds.h" // cl/: lt_light_bounds, lt_sphere_of_box
 
 #include <cmath>
 #include <cstddef>

@@ -1,4 +1,4 @@
-#include "lighttree/light_sampler.h"
+#include "light_tree/light_sampler.h"
 
 #include <cmath>
 #include <stdexcept>

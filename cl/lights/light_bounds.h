@@ -4,9 +4,9 @@
 #ifndef CANOPY_LIGHT_BOUNDS_H
 #define CANOPY_LIGHT_BOUNDS_H
 
-#include "compat.h"
-#include "simd4.h"
-#include "types.h"
+#include "../compat.h"
+#include "../simd4.h"
+#include "../types.h"
 
 // ---------------------------------------------------------------- emitter bounds (Table 1)
 // Bounds of one light: bbox, cone (as cosines; theta_o is 0 for one-sided flat emitters, pi for
@@ -68,7 +68,7 @@ LT_HOT void lt_light_bounds(GLOBAL const Light* L, float3* bmin, float3* bmax, f
   } else if (L->type == LIGHT_DISK) {
     // Oriented like a quad. Box: the disk's extent along axis i is r sqrt(1 - n_i^2) (the
     // projection of a circle), padded by 2^-20 of r and of |centre| so the box holds the sampled
-    // points despite their rounding (cl/light_sample.h).
+    // points despite their rounding (cl/lights/light_sample.h).
     float3 n = xyz_of(L->n);
     float r = fabs(L->p.w);
     float nl = length(n);

@@ -1,7 +1,7 @@
-#include "lighttree/synthetic_lights.h"
+#include "light_tree/synthetic_lights.h"
 
 #include "light_tree/cone.h" // lt_any_perpendicular
-#include "light_tree/rng.h"
+#include "rng.h"
 #include "shading.h"
 
 #include <cmath>
