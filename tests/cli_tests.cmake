@@ -143,6 +143,12 @@ canopy_cli_test(cli_converge_bad_split_suffix
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|brdf-mis/split=2"
   -DRC=2 "-DSTDERR=--samplers: 'brdf-mis/split=2': /split=T: T must be a number in [0, 1]"
   -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
+# Issue 21: "/nmax=N" sets the BRDF samplers' N_max (render --brdf-nmax's range), refused before
+# rendering when out of range.
+canopy_cli_test(cli_converge_bad_nmax_suffix
+  "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|brdf-mis/nmax=0"
+  -DRC=2 "-DSTDERR=--samplers: 'brdf-mis/nmax=0': /nmax=N: N must be an integer in [1, 1024]"
+  -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_converge_bsdf_nomis
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|bsdf/nomis"
   -DRC=2 "-DSTDERR=--samplers: 'bsdf/nomis': /nomis does not apply to bsdf (BSDF sampling only: there is no light sample to combine with)"

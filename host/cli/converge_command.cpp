@@ -73,6 +73,7 @@ constexpr std::string_view kNoMisSuffix = "nomis";       // after a '/'
 constexpr std::string_view kEqualSuffix = "equal";       // after a '/'
 constexpr std::string_view kMidpointSuffix = "midpoint"; // after a '/'
 constexpr std::string_view kSplitSuffix = "split=";      // after a '/', then the threshold
+constexpr std::string_view kNmaxSuffix = "nmax=";        // after a '/', then brdf-mis' N_max
 constexpr float kMaxBrdfDelta = 1000.0f;                 // as `canopy render --brdf-delta`
 
 bool is_brdf_sampler(const std::string& sampler) {
@@ -142,7 +143,7 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
   c.brdf.lambda = scene.brdf_lambda;
   c.brdf.adaptive = true;
   std::string spec = text;
-  bool equal = false, split_set = false;
+  bool equal = false, split_set = false, nmax_set = false;
   if (size_t slash = spec.find('/'); slash != std::string::npos) {
     std::stringstream suffixes(spec.substr(slash + 1));
     spec.resize(slash);
@@ -167,12 +168,24 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
                                        printable(text, 256), kSplitSuffix));
         c.threshold = float(v);
         split_set = true;
+      } else if (suffix.starts_with(kNmaxSuffix) && !nmax_set) {
+        // "/nmax=N": the BRDF samplers' most BRDF-aware samples per glossy point (Eq. 9).
+        std::string t = suffix.substr(kNmaxSuffix.size());
+        char* end = nullptr;
+        long v = std::strtol(t.c_str(), &end, 10);
+        if (t.empty() || *end != '\0' || v < 1 || v > kMaxBrdfSamples)
+          throw SceneError(fmt::format("{}: '{}': /{}N: N must be an integer in [1, {}]", option,
+                                       printable(text, 256), kNmaxSuffix, kMaxBrdfSamples));
+        c.brdf.n_max = int(v);
+        nmax_set = true;
       } else {
         throw SceneError(fmt::format("{}: '{}': unknown or repeated suffix '/{}' (/{}: MIS off; "
                                      "/{}: brdf-mis with equal allocation; /{}: medium segments "
-                                     "ranked at their midpoint; /{}T: split threshold T)",
+                                     "ranked at their midpoint; /{}T: split threshold T; "
+                                     "/{}N: brdf-mis' N_max)",
                                      option, printable(text, 256), printable(suffix, 256),
-                                     kNoMisSuffix, kEqualSuffix, kMidpointSuffix, kSplitSuffix));
+                                     kNoMisSuffix, kEqualSuffix, kMidpointSuffix, kSplitSuffix,
+                                     kNmaxSuffix));
       }
     }
     if (!any)
@@ -943,7 +956,9 @@ CLI::App* add_converge_command(CLI::App& app, std::function<int()>& action) {
                   "importance; a trailing /nomis switches MIS off (e.g. power/nomis, "
                   "tree-split:0.25/nomis; not for bsdf, brdf-mis, brdf-oriented), else MIS is on; "
                   "brdf-mis:D and brdf-oriented:D set the BRDF split threshold delta D; "
-                  "brdf-mis/equal allocates BRDF-aware samples equally (else adaptively)")
+                  "brdf-mis/equal allocates BRDF-aware samples equally (else adaptively); "
+                  "/split=T sets the split threshold where :T means delta; /nmax=N the BRDF "
+                  "samplers' most BRDF-aware samples per glossy point")
       ->capture_default_str();
   cmd->add_option("--budget", a->budget, "Render seconds per configuration (all points and seeds)")
       ->check(CLI::PositiveNumber)
