@@ -14,18 +14,22 @@
 //
 // Unbiasedness with adaptive counts (DESIGN "MIS with splitting", extended): the tree estimate
 // (one sample, density p_L) gets the power-heuristic weight w_L = p_L^2 / (p_L^2 + (N q)^2) with
-// a density q = s p_B + (1 - s) p_S fixed before any BRDF-aware sample is drawn, and each
+// a density q = s p_B' + (1 - s) p_S fixed before any BRDF-aware sample is drawn, and each
 // BRDF-aware sample i the weight (1 - w_L) / N divided by its own density q_i = p_i p_B +
 // (1 - p_i) p_S, where p_i is known before the sample is drawn. w_L + (1 - w_L) = 1 for every light
 // point, and each BRDF-aware sample is unbiased for (1 - w_L) f / N given the samples before it,
 // so the sum is unbiased however p_i adapts. (Weights computed from the realised counts, as a
 // plain reading of the paper suggests, would depend on the samples they weight and bias the
 // estimate.) The share s is the mean of p_i over the N samples if no BSDF sample finds an emitter
-// (brdf_expected_share), the case BRDF-oriented sampling is for; there q matches the samples'
-// densities. Equal allocation (adaptive = false) draws one sample of each technique (s = p_i = 1/2,
-// stratified: sample 0 light, sample 1 BSDF; q_i = q), which makes the weights exactly the power
-// heuristic over the three techniques with counts 1, 1, 1 up to the grouping of the BRDF-aware
-// two. brdf-oriented alone: p_i = 1, no tree estimate (w_L = 0).
+// (brdf_expected_share), the case BRDF-oriented sampling is for. w_L only has to be a function of
+// the light point, so p_B' is a cheap stand-in for the BRDF-oriented density p_B
+// (lt_brdf_pmf_weight: exact to the cut entry, the tree's descent below it): the exact one costs
+// four cap integrals per level of the light's trail, for every tree sample at a glossy point
+// (docs/performance.md, "BRDF-oriented sampling at tree cost"). Only q_i, a sample's own density,
+// needs the exact p_B. Equal allocation (adaptive = false) draws one sample of each technique
+// (s = p_i = 1/2, stratified: sample 0 light, sample 1 BSDF; q_i = q), which makes the weights
+// the power heuristic over the three techniques with counts 1, 1, 1 up to the grouping of the
+// BRDF-aware two and p_B'. brdf-oriented alone: p_i = 1, no tree estimate (w_L = 0).
 //
 // The BSDF samples replace the path's own bounce for direct lighting: emission found by the
 // continuation ray from a glossy point is not counted (shade_surface.h), as the point's direct
@@ -104,12 +108,22 @@ INLINE float brdf_light_pmf(const LightSamplerCtx* ls, const BrdfPoint* bp, int 
   return lt_brdf_pmf(&ls->tree, bp->cut, bp->state.x, bp->P, bp->Nq, &bp->lobe, light);
 }
 
+// The stand-in p_B' of the MIS weights for `light` at the path's glossy point (see the top): its
+// cut and its query, without the material and cap lobe of a BrdfPoint.
+INLINE float brdf_light_pmf_weight(const LightSamplerCtx* ls, const PathBuffers* pb, int path,
+                                   int light) {
+  return lt_brdf_pmf_weight(&ls->tree, ls->brdf_cut + (size_t)path * LT_BRDF_MAX_CUT,
+                            pb->brdf_state[path].x, xyz_of(pb->shade_P[path]),
+                            light_query_normal(pb, path), light);
+}
+
 // Weight of the tree light sample (density p_L) against N BRDF-aware samples drawn with share s
-// of BRDF-oriented light sampling (see the top).
-INLINE float brdf_weight_tree(const LightSamplerCtx* ls, float p_L, float p_B, float p_S, int N,
+// of BRDF-oriented light sampling; p_B' = brdf_light_pmf_weight times the light's density (see
+// the top).
+INLINE float brdf_weight_tree(const LightSamplerCtx* ls, float p_L, float p_Bw, float p_S, int N,
                               float s) {
   if (ls->kind == SAMPLER_BRDF_ORIENTED) return 0.0f;
-  return power_heuristic(p_L, (float)N * (s * p_B + (1.0f - s) * p_S));
+  return power_heuristic(p_L, (float)N * (s * p_Bw + (1.0f - s) * p_S));
 }
 
 // Mean of Alg. 1's p over N samples when every BSDF sample misses, in the fluid limit: after
@@ -194,7 +208,10 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
       if (ls->kind != SAMPLER_BRDF_ORIENTED)
         p_L = lt_pmf_split(&ls->tree, bp.P, bp.Nq, light, ls->threshold, ls->max_cut) * lp.s.pdf;
       float q = p_i * p_B + (1.0f - p_i) * lp.bsdf_pdf;
-      float w = 1.0f - brdf_weight_tree(ls, p_L, p_B, lp.bsdf_pdf, st.y, pb->brdf_share[path]);
+      float p_Bw = 0.0f;
+      if (ls->kind != SAMPLER_BRDF_ORIENTED)
+        p_Bw = brdf_light_pmf_weight(ls, pb, path, light) * lp.s.pdf;
+      float w = 1.0f - brdf_weight_tree(ls, p_L, p_Bw, lp.bsdf_pdf, st.y, pb->brdf_share[path]);
       float3 c = beta * lp.f_cos * lp.s.Li * (w * inv_n / q);
       if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) continue;
       it.origin = lp.origin;
@@ -258,12 +275,14 @@ INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls,
   BrdfPoint bp = brdf_point(ls, sc, pb, path);
   float pdf_y = light_pdf(&ls->lights[light], bp.P, y);
   float p_B = brdf_light_pmf(ls, &bp, light) * pdf_y;
-  float p_L = 0.0f;
-  if (ls->kind != SAMPLER_BRDF_ORIENTED)
+  float p_L = 0.0f, p_Bw = 0.0f;
+  if (ls->kind != SAMPLER_BRDF_ORIENTED) {
     p_L = lt_pmf_split(&ls->tree, bp.P, bp.Nq, light, ls->threshold, ls->max_cut) * pdf_y;
+    p_Bw = brdf_light_pmf_weight(ls, pb, path, light) * pdf_y;
+  }
   float p_S = it.extra.x, p_i = it.extra.y;
   float q = p_i * p_B + (1.0f - p_i) * p_S;
-  float w = 1.0f - brdf_weight_tree(ls, p_L, p_B, p_S, bp.state.y, pb->brdf_share[path]);
+  float w = 1.0f - brdf_weight_tree(ls, p_L, p_Bw, p_S, bp.state.y, pb->brdf_share[path]);
   item->value = f4_from3(xyz_of(it.value) * Le * (w / q), 0.0f);
   item->extra.w = 1.0f;
 }

@@ -31,9 +31,8 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   float p_L = pmf * lp.s.pdf;
   if (HAS_MICROFACET && light_sampler_brdf(ls) && f_w == BRDF_POINT_FLAG) {
     // A glossy point: against its N BRDF-aware samples (brdf_mis.h).
-    BrdfPoint bp = brdf_point(ls, sc, pb, path);
-    w = brdf_weight_tree(ls, p_L, brdf_light_pmf(ls, &bp, light) * lp.s.pdf, lp.bsdf_pdf,
-                         bp.state.y, pb->brdf_share[path]);
+    w = brdf_weight_tree(ls, p_L, brdf_light_pmf_weight(ls, pb, path, light) * lp.s.pdf,
+                         lp.bsdf_pdf, pb->brdf_state[path].y, pb->brdf_share[path]);
   } else if (f_w > 0.0f) {
     // MIS against BSDF sampling when the path continues with it (bsdf_pdf 0: delta lights).
     w = power_heuristic(p_L, lp.bsdf_pdf);

@@ -9,9 +9,10 @@
 
 #include "../bsdf/cap_integral.h"
 #include "../compat.h"
+#include "discrete.h"
 #include "importance.h"
 #include "layout.h"
-#include "discrete.h"
+#include "pmf.h"
 
 // Capacity of a point's cut. The paper's cuts average 3.4 (delta 0.5) to 51 (delta 0.005) clusters
 // (Table 2); a cut that would grow past this stops splitting (it still covers every light, so the
@@ -276,6 +277,29 @@ INLINE float lt_brdf_pmf(const LtTree* t, GLOBAL const float2* cut, int n, float
     int j = lt_brdf_cut_find(cut, n, code);
     if (j >= 0)
       return lt_brdf_entry_prob(cut, n, j) * lt_brdf_pmf_below(t, code, trail, P, Ng, lobe);
+    if (code == LT_EMPTY) return 0.0f;
+    int lane = (int)(trail & 3u);
+    trail = trail >> 2;
+    if (code < 0) { // a split leaf: the emitter's own entry, if P's cut kept it
+      j = lt_brdf_cut_find(cut, n, lt_leaf_code(lt_leaf_first(code) + lane, 1));
+      return j >= 0 ? lt_brdf_entry_prob(cut, n, j) : 0.0f;
+    }
+    code = i4_get(t->children[code], lane);
+  }
+}
+
+// A cheap stand-in for lt_brdf_pmf in MIS weights, which need only be some function of the
+// light (brdf_mis.h): the exact probability of the cut entry that holds the light times the
+// probability of Conty Estevez & Kulla's descent below it (pmf.h), where the sampler descends by
+// Eq. 6. The entries are chosen by the BRDF, so this follows the lobe at the cut's resolution,
+// without the four cap integrals per level of the exact pmf.
+INLINE float lt_brdf_pmf_weight(const LtTree* t, GLOBAL const float2* cut, int n, float3 P,
+                                float3 Nq, int light) {
+  uint trail = t->trails[light];
+  int code = 0;
+  for (;;) {
+    int j = lt_brdf_cut_find(cut, n, code);
+    if (j >= 0) return lt_brdf_entry_prob(cut, n, j) * lt_pmf_below(t, code, P, Nq, trail);
     if (code == LT_EMPTY) return 0.0f;
     int lane = (int)(trail & 3u);
     trail = trail >> 2;
