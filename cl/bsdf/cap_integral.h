@@ -27,7 +27,7 @@
 #include "sptd_table.h"
 #endif
 
-// Per shading point. float4s so the layout is the same 64 bytes in OpenCL C (float3 is 16 bytes
+// Per shading point. float4s so the layout is the same 96 bytes in OpenCL C (float3 is 16 bytes
 // there) and C++. The glossy part of S for a cap C is the SPTD integral
 // amp |P(C) n P(H)| fres_lobe (the lobe's mean Fresnel), blended for caps small against the lobe
 // with the exact GGX f cos at the centre times |C| (Fresnel from cap_fresnel at its half vector;
@@ -39,6 +39,11 @@ typedef struct CapLobe {
              // (plastic), 0 for no glossy lobe
   float fres0, fres1, fres2; // the Fresnel factor's parameters (cap_fresnel)
   float amp;                 // SPTD amplitude: the lobe's albedo / |P(H)|
+  // The pivot image P(H) of the horizon cap: xyz its axis, w its cos; and its sin, m = 1 - |xi|^2.
+  // The same for every cap of the point, so computed once (cap_lobe_integral runs per cluster).
+  float4 horizon;
+  float horizon_sin, m;
+  float pad0, pad1;
 } CapLobe;
 
 #if HAS_MICROFACET
@@ -234,6 +239,11 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
   l.fres1 = 0.0f;
   l.fres2 = 0.0f;
   l.amp = 0.0f;
+  l.horizon = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+  l.horizon_sin = 0.0f;
+  l.m = 0.0f;
+  l.pad0 = 0.0f;
+  l.pad1 = 0.0f;
   int diffuse_base = 1;
 #if HAS_MICROFACET
   int glossy_type = IS_MATERIAL(m, MATERIAL_CONDUCTOR) || IS_MATERIAL(m, MATERIAL_PLASTIC);
@@ -256,11 +266,12 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
     float tl = length(tw);
     float3 t = tl > 1e-7f ? tw * (1.0f / tl) : fr->t;
     float3 xi = (t * sin(angle) + n * cos(angle)) * norm;
-    // 1 - |xi|^2 as cap_lobe_integral recomputes it from the stored xi (no room for it: the
-    // float error, ~1e-7, is < 1e-3 of it even for alpha = 1e-4 at grazing angles).
     float mm = cap_pivot_m(xi);
     float hs, hc;
-    cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
+    float3 ha = cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
+    l.horizon = f4_from3(ha, hc);
+    l.horizon_sin = hs;
+    l.m = mm;
     // amplitude = albedo / (|P(H)| / 4 pi) and S = amplitude |P(C) n P(H)| / 4 pi.
     float ph = cap_solid_angle(hs, hc);
     l.amp = ph > 0.0f ? albedo / ph : 0.0f;
@@ -361,11 +372,10 @@ INLINE float cap_lobe_integral(const CapLobe* l, float3 c, float sin_u, float co
     if (w < 1.0f) {
       // The SPTD integral with the lobe's mean Fresnel (docs/cap-integral.md compares per-cap
       // Fresnel factors: none did better, and they cost up to a quarter more).
-      float mm = cap_pivot_m(xi);
-      float hs, hc, ps, pc;
-      float3 ha = cap_pivot(xi, mm, n, 1.0f, 0.0f, &hs, &hc);
-      float3 pa = cap_pivot(xi, mm, c, sin_u, cos_u, &ps, &pc);
-      s_g += (1.0f - w) * l->amp * l->xi.w * cap_intersection_area(pa, ps, pc, ha, hs, hc);
+      float ps, pc;
+      float3 pa = cap_pivot(xi, l->m, c, sin_u, cos_u, &ps, &pc);
+      s_g += (1.0f - w) * l->amp * l->xi.w *
+             cap_intersection_area(pa, ps, pc, xyz_of(l->horizon), l->horizon_sin, l->horizon.w);
     }
     s += s_g;
   }
