@@ -31,6 +31,14 @@ INLINE int i4_get(int4 v, int i) {
 INLINE float4 f4_splat(float x) {
   return (float4)(x);
 }
+// Bit i set where lane i's sign bit is (a comparison's -1, or a negative int).
+INLINE int sign_bits4(int4 v) {
+  return ((v.x >> 31) & 1) | ((v.y >> 31) & 2) | ((v.z >> 31) & 4) | ((v.w >> 31) & 8);
+}
+// The index of the lowest set bit of x != 0.
+INLINE int lowest_bit(int x) {
+  return 31 - clz(x & -x);
+}
 INLINE bool is_finite_f(float x) {
   return isfinite(x);
 }
@@ -44,6 +52,7 @@ INLINE float uint_as_float_(uint x) {
 #else
 // ---------------------------------------------------------------- C++
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -105,6 +114,12 @@ INLINE int i4_get(int4 v, int i) {
 }
 INLINE float4 f4_splat(float x) {
   return {x, x, x, x};
+}
+INLINE int sign_bits4(int4 v) {
+  return ((v.x >> 31) & 1) | ((v.y >> 31) & 2) | ((v.z >> 31) & 4) | ((v.w >> 31) & 8);
+}
+INLINE int lowest_bit(int x) {
+  return std::countr_zero(unsigned(x));
 }
 INLINE bool is_finite_f(float x) {
   return std::isfinite(x);

@@ -199,25 +199,13 @@ INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL LeafBlock* le
     const GLOBAL BvhNode* n = &nodes[node];
     float4 t4 = bvh_node_entry(n, o, inv_d, tmin, tmax);
     int4 c4 = n->child;
-    int next[4];
-    float next_t[4];
-    int m = 0;
-    for (int lane = 0; lane < 4; ++lane) {
-      float t = f4_get(t4, lane);
-      int c = i4_get(c4, lane);
-      if (t == FLT_INF || !(t <= tmax)) continue; // missed or empty (tmax may be infinite)
-      if (c >= 0) {
-        // insertion by distance, nearest first
-        int k = m++;
-        while (k > 0 && next_t[k - 1] > t) {
-          next[k] = next[k - 1];
-          next_t[k] = next_t[k - 1];
-          --k;
-        }
-        next[k] = c;
-        next_t[k] = t;
-        continue;
-      }
+    float lane_t[4] = {t4.x, t4.y, t4.z, t4.w};
+    int lane_c[4] = {c4.x, c4.y, c4.z, c4.w};
+    // lanes entered before tmax (a missed or empty lane has t = INFINITY; tmax may be infinite)
+    int entered = sign_bits4((t4 != f4_splat(FLT_INF)) & (t4 <= f4_splat(tmax)));
+    int leaves = entered & sign_bits4(c4);
+    for (; leaves != 0; leaves &= leaves - 1) {
+      int c = lane_c[lowest_bit(leaves)];
       int first = bvh_leaf_first(c), end = first + bvh_leaf_count(c);
       for (int b = first; b < end; ++b) {
         const GLOBAL LeafBlock* blk = &leaf_blocks[b];
@@ -252,6 +240,22 @@ INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL LeafBlock* le
       if (any_hit && best >= 0) break;
     }
     if (any_hit && best >= 0) break;
+    // Interior children, by insertion nearest first.
+    int next[4];
+    float next_t[4];
+    int m = 0;
+    for (int inner = entered & ~sign_bits4(c4); inner != 0; inner &= inner - 1) {
+      int lane = lowest_bit(inner);
+      float t = lane_t[lane];
+      int k = m++;
+      while (k > 0 && next_t[k - 1] > t) {
+        next[k] = next[k - 1];
+        next_t[k] = next_t[k - 1];
+        --k;
+      }
+      next[k] = lane_c[lane];
+      next_t[k] = t;
+    }
     // Visit the nearest child that is still closer than the best hit; push the others, farthest
     // first, so the second nearest is popped next.
     node = -1;

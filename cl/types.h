@@ -94,6 +94,7 @@ typedef struct BvhNode {
   float4 min_x, min_y, min_z;
   float4 max_x, max_y, max_z;
   int4 child;
+  int4 pad; // 128 bytes: a node spans two whole cache lines, not three
 } BvhNode;
 
 // Up to four primitives of a BVH leaf, stored in leaf order as a struct of arrays: lane i of each
