@@ -1,10 +1,12 @@
 // Closest-hit throughput of the OpenCL intersect kernel against Embree (rtcIntersect1 and
-// rtcIntersect8) on the same batch of incoherent rays over the same mesh, both using every core.
-//   canopy_bench --benchmark_filter=Intersect
+// rtcIntersect8) on the same batch of incoherent rays over the same mesh, and shadow-segment
+// throughput of the intersect_shadow kernel against rtcOccluded1, all using every core.
+//   canopy_bench --benchmark_filter='Intersect|Occluded'
 #include "accel/bvh.h"
 #include "cl/runtime.h"
 #include "support/closest_hit_kernel.h"
 #include "support/procedural_mesh.h"
+#include "support/shadow_kernel.h"
 
 #include <benchmark/benchmark.h>
 #include <tbb/parallel_for.h>
@@ -20,6 +22,7 @@ constexpr int kRayCount = 1 << 20;
 struct IntersectFixture {
   std::vector<Primitive> prims = testing::make_mesh(400, 200, 40000); // 200k triangles
   testing::Rays rays = testing::make_rays(prims, kRayCount);
+  testing::Rays shadow_rays = testing::make_shadow_rays(prims, kRayCount);
   Bvh bvh = build_bvh(prims);
   EmbreeReference embree{prims};
 };
@@ -98,8 +101,57 @@ void Intersect_Embree8(benchmark::State& state) {
   set_rate(state, int64_t(state.iterations()) * kRayCount);
 }
 
+void Occluded_OpenCL(benchmark::State& state) {
+  const size_t local = size_t(state.range(0));
+  IntersectFixture& f = fixture();
+  ClRuntime rt;
+  cl::Program program = rt.build_program({"kernels/intersect_shadow.cl"});
+  testing::ShadowKernel kernel(rt, program, f.bvh, f.prims, f.shadow_rays);
+  for (auto _ : state)
+    kernel.run(local);
+  set_rate(state, int64_t(state.iterations()) * kRayCount);
+}
+
+void Occluded_Embree1(benchmark::State& state) {
+  IntersectFixture& f = fixture();
+  const testing::Rays& rays = f.shadow_rays;
+  std::vector<int> occluded(rays.o.size());
+  for (auto _ : state) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.o.size(), 4096), [&](const auto& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i)
+        occluded[i] = f.embree.occluded(xyz_of(rays.o[i]), xyz_of(rays.d[i]), 0.0f, rays.o[i].w);
+    });
+    benchmark::DoNotOptimize(occluded.data());
+  }
+  set_rate(state, int64_t(state.iterations()) * kRayCount);
+}
+
 } // namespace
 
-BENCHMARK(Intersect_OpenCL)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
-BENCHMARK(Intersect_Embree1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
-BENCHMARK(Intersect_Embree8)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(Intersect_OpenCL)
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime()
+    ->MinTime(2.0);
+BENCHMARK(Intersect_Embree1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime()
+    ->MinTime(2.0);
+BENCHMARK(Intersect_Embree8)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime()
+    ->MinTime(2.0);
+BENCHMARK(Occluded_OpenCL)
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime()
+    ->MinTime(2.0);
+BENCHMARK(Occluded_Embree1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime()
+    ->MinTime(2.0);

@@ -28,6 +28,17 @@ INLINE float f4_get(float4 v, int i) {
 INLINE int i4_get(int4 v, int i) {
   return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w));
 }
+INLINE float4 f4_splat(float x) {
+  return (float4)(x);
+}
+// Bit i set where lane i's sign bit is (a comparison's -1, or a negative int).
+INLINE int sign_bits4(int4 v) {
+  return ((v.x >> 31) & 1) | ((v.y >> 31) & 2) | ((v.z >> 31) & 4) | ((v.w >> 31) & 8);
+}
+// The index of the lowest set bit of x != 0.
+INLINE int lowest_bit(int x) {
+  return 31 - clz(x & -x);
+}
 INLINE bool is_finite_f(float x) {
   return isfinite(x);
 }
@@ -41,6 +52,7 @@ INLINE float uint_as_float_(uint x) {
 #else
 // ---------------------------------------------------------------- C++
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -99,6 +111,15 @@ INLINE float f4_get(float4 v, int i) {
 }
 INLINE int i4_get(int4 v, int i) {
   return i == 0 ? v.x : (i == 1 ? v.y : (i == 2 ? v.z : v.w));
+}
+INLINE float4 f4_splat(float x) {
+  return {x, x, x, x};
+}
+INLINE int sign_bits4(int4 v) {
+  return ((v.x >> 31) & 1) | ((v.y >> 31) & 2) | ((v.z >> 31) & 4) | ((v.w >> 31) & 8);
+}
+INLINE int lowest_bit(int x) {
+  return std::countr_zero(unsigned(x));
 }
 INLINE bool is_finite_f(float x) {
   return std::isfinite(x);
@@ -200,6 +221,45 @@ INLINE float4 fmax(float4 a, float4 b) {
 }
 INLINE float4 sqrt(float4 a) {
   return {std::sqrt(a.x), std::sqrt(a.y), std::sqrt(a.z), std::sqrt(a.w)};
+}
+INLINE float4 fabs(float4 a) {
+  return {std::fabs(a.x), std::fabs(a.y), std::fabs(a.z), std::fabs(a.w)};
+}
+
+// Lane-wise comparisons and masks as OpenCL C has them: -1 (all bits) where true, else 0.
+INLINE int4 mask4(bool x, bool y, bool z, bool w) {
+  return {-int(x), -int(y), -int(z), -int(w)};
+}
+INLINE int4 operator<(float4 a, float4 b) {
+  return mask4(a.x < b.x, a.y < b.y, a.z < b.z, a.w < b.w);
+}
+INLINE int4 operator>(float4 a, float4 b) {
+  return mask4(a.x > b.x, a.y > b.y, a.z > b.z, a.w > b.w);
+}
+INLINE int4 operator<=(float4 a, float4 b) {
+  return mask4(a.x <= b.x, a.y <= b.y, a.z <= b.z, a.w <= b.w);
+}
+INLINE int4 operator==(float4 a, float4 b) {
+  return mask4(a.x == b.x, a.y == b.y, a.z == b.z, a.w == b.w);
+}
+INLINE int4 operator!=(float4 a, float4 b) {
+  return mask4(a.x != b.x, a.y != b.y, a.z != b.z, a.w != b.w);
+}
+INLINE int4 operator&(int4 a, int4 b) {
+  return {a.x & b.x, a.y & b.y, a.z & b.z, a.w & b.w};
+}
+INLINE int4 operator|(int4 a, int4 b) {
+  return {a.x | b.x, a.y | b.y, a.z | b.z, a.w | b.w};
+}
+INLINE int4 operator~(int4 a) {
+  return {~a.x, ~a.y, ~a.z, ~a.w};
+}
+INLINE int any(int4 m) {
+  return (m.x | m.y | m.z | m.w) < 0;
+}
+// select(a, b, m): b where m's sign bit is set, else a.
+INLINE float4 select(float4 a, float4 b, int4 m) {
+  return {m.x < 0 ? b.x : a.x, m.y < 0 ? b.y : a.y, m.z < 0 ? b.z : a.z, m.w < 0 ? b.w : a.w};
 }
 
 // scalar built-ins with their OpenCL names

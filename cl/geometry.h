@@ -12,7 +12,7 @@
 #define BVH_MAX_DEPTH 30
 #define BVH_STACK_SIZE (3 * BVH_MAX_DEPTH + 4)
 #define BVH_EMPTY (-2147483647 - 1)
-#define BVH_MAX_LEAF 16
+#define BVH_MAX_LEAF 16 // primitives; a leaf has up to 4 blocks of 4
 
 INLINE int bvh_is_leaf(int code) {
   return code < 0 && code != BVH_EMPTY;
@@ -67,6 +67,37 @@ INLINE int ray_triangle(float3 o, float3 d, float3 v0, float3 e1, float3 e2, flo
   *u_out = u;
   *v_out = v;
   return 1;
+}
+
+// ray_triangle on the four lanes of a leaf block at once, with the same arithmetic lane by lane
+// (so the same hits and the same t, u, v). Returns -1 in the lanes hit inside (tmin, tmax).
+INLINE int4 ray_triangle4(float3 o, float3 d, const GLOBAL LeafBlock* b, float tmin, float tmax,
+                          float4* t_out, float4* u_out, float4* v_out) {
+  float4 dx = f4_splat(d.x), dy = f4_splat(d.y), dz = f4_splat(d.z);
+  float4 e1x = b->e1_x, e1y = b->e1_y, e1z = b->e1_z;
+  float4 e2x = b->e2_x, e2y = b->e2_y, e2z = b->e2_z;
+  float4 px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
+  float4 det = e1x * px + e1y * py + e1z * pz;
+  float4 inv_det = f4_splat(1.0f) / det;
+  float4 sx = f4_splat(o.x) - b->v0_x, sy = f4_splat(o.y) - b->v0_y, sz = f4_splat(o.z) - b->v0_z;
+  float4 u = (sx * px + sy * py + sz * pz) * inv_det;
+  float4 qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
+  float4 v = (dx * qx + dy * qy + dz * qz) * inv_det;
+  float4 t = (e2x * qx + e2y * qy + e2z * qz) * inv_det;
+  float4 asx = fabs(sx), asy = fabs(sy), asz = fabs(sz);
+  float4 a1x = fabs(e1x), a1y = fabs(e1y), a1z = fabs(e1z);
+  float4 aqx = asy * a1z + asz * a1y, aqy = asz * a1x + asx * a1z, aqz = asx * a1y + asy * a1x;
+  float4 t_err = f4_splat(fp_gamma(8)) * (fabs(e2x) * aqx + fabs(e2y) * aqy + fabs(e2z) * aqz) *
+                     fabs(inv_det) +
+                 f4_splat(fp_gamma(4)) * t;
+  float4 zero = f4_splat(0.0f), one = f4_splat(1.0f);
+  // Written as ray_triangle's rejections, negated, so NaNs fall the same way.
+  int4 hit = (det != zero) & ~((u < zero) | (u > one)) & ~((v < zero) | (u + v > one)) &
+             (t > f4_splat(tmin)) & (t < f4_splat(tmax)) & ~(t <= t_err);
+  *t_out = t;
+  *u_out = u;
+  *v_out = v;
+  return hit;
 }
 
 // Ray-sphere, with the discriminant computed from the perpendicular offset to avoid the
@@ -154,7 +185,7 @@ INLINE float4 bvh_node_entry(const GLOBAL BvhNode* n, float3 o, float3 inv_d, fl
 // at once (shrinking tmax before the interior children are ordered); interior children are visited
 // nearest first, the others pushed with their entry distance and skipped on pop if a closer hit
 // was found meanwhile.
-INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL int* prim_index,
+INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL LeafBlock* leaf_blocks,
                          const GLOBAL Primitive* prims, float3 o, float3 d, float tmin, float tmax,
                          int any_hit, Hit* hit) {
   float3 inv_d = make_float3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
@@ -168,40 +199,63 @@ INLINE int bvh_intersect(const GLOBAL BvhNode* nodes, const GLOBAL int* prim_ind
     const GLOBAL BvhNode* n = &nodes[node];
     float4 t4 = bvh_node_entry(n, o, inv_d, tmin, tmax);
     int4 c4 = n->child;
-    int next[4];
-    float next_t[4];
-    int m = 0;
-    for (int lane = 0; lane < 4; ++lane) {
-      float t = f4_get(t4, lane);
-      int c = i4_get(c4, lane);
-      if (t == FLT_INF || !(t <= tmax)) continue; // missed or empty (tmax may be infinite)
-      if (c >= 0) {
-        // insertion by distance, nearest first
-        int k = m++;
-        while (k > 0 && next_t[k - 1] > t) {
-          next[k] = next[k - 1];
-          next_t[k] = next_t[k - 1];
-          --k;
-        }
-        next[k] = c;
-        next_t[k] = t;
-        continue;
-      }
-      int first = bvh_leaf_first(c), count = bvh_leaf_count(c);
-      for (int i = 0; i < count; ++i) {
-        int p = prim_index[first + i];
-        float th, u, v;
-        if (ray_primitive(&prims[p], o, d, tmin, tmax, &th, &u, &v)) {
-          tmax = th;
-          best = p;
-          best_u = u;
-          best_v = v;
+    float lane_t[4] = {t4.x, t4.y, t4.z, t4.w};
+    int lane_c[4] = {c4.x, c4.y, c4.z, c4.w};
+    // lanes entered before tmax (a missed or empty lane has t = INFINITY; tmax may be infinite)
+    int entered = sign_bits4((t4 != f4_splat(FLT_INF)) & (t4 <= f4_splat(tmax)));
+    int leaves = entered & sign_bits4(c4);
+    for (; leaves != 0; leaves &= leaves - 1) {
+      int c = lane_c[lowest_bit(leaves)];
+      int first = bvh_leaf_first(c), end = first + bvh_leaf_count(c);
+      for (int b = first; b < end; ++b) {
+        const GLOBAL LeafBlock* blk = &leaf_blocks[b];
+        float4 th, u, v;
+        int4 lanes = ray_triangle4(o, d, blk, tmin, tmax, &th, &u, &v);
+        int4 ids = blk->prim;
+        if (any(lanes)) {
+          // The nearest lane, the first of equals (as testing the lanes in order would).
+          float4 tm = select(f4_splat(FLT_INF), th, lanes);
+          tmax = fmin(fmin(tm.x, tm.y), fmin(tm.z, tm.w));
+          int k = tm.x == tmax ? 0 : (tm.y == tmax ? 1 : (tm.z == tmax ? 2 : 3));
+          best = i4_get(ids, k);
+          best_u = f4_get(u, k);
+          best_v = f4_get(v, k);
           if (any_hit) break;
+        }
+        if ((HAS_PRIM_SPHERE || HAS_PRIM_DISK) && min(min(ids.x, ids.y), min(ids.z, ids.w)) < -1) {
+          for (int k = 0; k < 4; ++k) {
+            int p = -2 - i4_get(ids, k);
+            float tp, up, vp;
+            if (p >= 0 && ray_primitive(&prims[p], o, d, tmin, tmax, &tp, &up, &vp)) {
+              tmax = tp;
+              best = p;
+              best_u = up;
+              best_v = vp;
+              if (any_hit) break;
+            }
+          }
+          if (any_hit && best >= 0) break;
         }
       }
       if (any_hit && best >= 0) break;
     }
     if (any_hit && best >= 0) break;
+    // Interior children, by insertion nearest first.
+    int next[4];
+    float next_t[4];
+    int m = 0;
+    for (int inner = entered & ~sign_bits4(c4); inner != 0; inner &= inner - 1) {
+      int lane = lowest_bit(inner);
+      float t = lane_t[lane];
+      int k = m++;
+      while (k > 0 && next_t[k - 1] > t) {
+        next[k] = next[k - 1];
+        next_t[k] = next_t[k - 1];
+        --k;
+      }
+      next[k] = lane_c[lane];
+      next_t[k] = t;
+    }
     // Visit the nearest child that is still closer than the best hit; push the others, farthest
     // first, so the second nearest is popped next.
     node = -1;

@@ -88,12 +88,27 @@ typedef struct Primitive {
 
 // 4-wide BVH node, struct of arrays: lane i of each float4 is child i's box, so one node's four
 // boxes are tested with float4 arithmetic. child[i] >= 0: an interior node; BVH_EMPTY: unused
-// lane; other negative values: a leaf of prim_index[first .. first + count), see bvh_leaf_*.
+// lane; other negative values: a leaf of the blocks leaf_blocks[first .. first + count), see
+// bvh_leaf_*.
 typedef struct BvhNode {
   float4 min_x, min_y, min_z;
   float4 max_x, max_y, max_z;
   int4 child;
+  int4 pad; // 128 bytes: a node spans two whole cache lines, not three
 } BvhNode;
+
+// Up to four primitives of a BVH leaf, stored in leaf order as a struct of arrays: lane i of each
+// float4 is triangle i's v0, e1 = v1 - v0 and e2 = v2 - v0, so a leaf's triangles are tested at
+// once with float4 arithmetic from contiguous memory (reading them through an index into the
+// scene's primitives cost a cache miss per triangle). prim[i] is the lane's index into the scene's
+// primitives; -1: an empty lane; -2 - p: primitive p is a sphere or a disk (its lane's edges are
+// zero, so the triangle test misses it; the traversal tests prims[p] instead).
+typedef struct LeafBlock {
+  float4 v0_x, v0_y, v0_z;
+  float4 e1_x, e1_y, e1_z;
+  float4 e2_x, e2_y, e2_z;
+  int4 prim;
+} LeafBlock;
 
 // ---------------------------------------------------------------- camera
 typedef struct CameraParams {

@@ -105,13 +105,13 @@ protected:
     geometry_ = build_scene_geometry(scene_, materials_);
   }
   SceneBuffers scene_buffers() {
-    return SceneBuffers{geometry_.bvh.nodes.data(),       geometry_.bvh.prim_index.data(),
+    return SceneBuffers{geometry_.bvh.nodes.data(),       geometry_.bvh.leaf_blocks.data(),
                         geometry_.prims.data(),           materials_.data(),
                         geometry_.shading_normals.data(), &scene_.medium}; // vacuum
   }
   bool occluded(float3 o, float3 d, float tmax) {
     Hit h;
-    return bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
+    return bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.leaf_blocks.data(),
                          geometry_.prims.data(), o, d, 0.0f, tmax, 1, &h) >= 0;
   }
 
@@ -220,7 +220,7 @@ protected:
     float3 wi = normalize(frame_to_world(&fr, bs.wi));
     if (bs.is_delta || !(bs.pdf > 0) || !(dot(wi, kN) > 0)) return zero;
     Hit h;
-    if (bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
+    if (bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.leaf_blocks.data(),
                       geometry_.prims.data(), kP, wi, 0.0f, FLT_INF, 0, &h) < 0)
       return zero;
     const Primitive* prim = &geometry_.prims[size_t(h.prim)];

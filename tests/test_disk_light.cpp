@@ -350,7 +350,7 @@ TEST(IntersectDisk, BvhOverDisksAndTrianglesMatchesBruteForce) {
     float3 o = make_float3(u(rng), u(rng), u(rng)) * 12.0f - make_float3(1, 1, 1);
     float3 d = random_unit(rng);
     Hit h;
-    bvh_intersect(bvh.nodes.data(), bvh.prim_index.data(), prims.data(), o, d, 0.0f, FLT_INF, 0,
+    bvh_intersect(bvh.nodes.data(), bvh.leaf_blocks.data(), prims.data(), o, d, 0.0f, FLT_INF, 0,
                   &h);
     int best = -1;
     float best_t = FLT_INF;
@@ -368,7 +368,7 @@ TEST(IntersectDisk, BvhOverDisksAndTrianglesMatchesBruteForce) {
       disk_hits += prims[size_t(best)].type == PRIM_DISK;
       // an any-hit query finds some hit too
       Hit ha;
-      ASSERT_GE(bvh_intersect(bvh.nodes.data(), bvh.prim_index.data(), prims.data(), o, d, 0.0f,
+      ASSERT_GE(bvh_intersect(bvh.nodes.data(), bvh.leaf_blocks.data(), prims.data(), o, d, 0.0f,
                               FLT_INF, 1, &ha),
                 0);
     }

@@ -154,7 +154,7 @@ protected:
       float z = 2 * u(rng) - 1, phi = 6.2831853f * u(rng), s = std::sqrt(std::max(0.0f, 1 - z * z));
       float3 d = make_float3(s * std::cos(phi), z, s * std::sin(phi));
       Hit h;
-      bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
+      bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.leaf_blocks.data(),
                     geometry_.prims.data(), o, d, 0.0f, FLT_INF, 0, &h);
       p.ray_o.push_back(f4_from3(o, 0));
       p.ray_d.push_back(f4_from3(d, 0));
@@ -208,7 +208,7 @@ protected:
                                scene_.medium);
   }
   SceneBuffers host_scene() {
-    return SceneBuffers{geometry_.bvh.nodes.data(),       geometry_.bvh.prim_index.data(),
+    return SceneBuffers{geometry_.bvh.nodes.data(),       geometry_.bvh.leaf_blocks.data(),
                         geometry_.prims.data(),           materials_.data(),
                         geometry_.shading_normals.data(), &scene_.medium};
   }
@@ -447,7 +447,7 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     }
     paths = ref; // the next depth starts from the shaded state and the bounce rays' hits
     for (size_t i = 0; i < paths.hits.size(); ++i)
-      bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.prim_index.data(),
+      bvh_intersect(geometry_.bvh.nodes.data(), geometry_.bvh.leaf_blocks.data(),
                     geometry_.prims.data(), xyz_of(paths.ray_o[i]), xyz_of(paths.ray_d[i]),
                     paths.ray_o[i].w, FLT_INF, 0, &paths.hits[i]);
   }

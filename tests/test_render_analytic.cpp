@@ -347,7 +347,7 @@ TEST_P(AreaLightMis, PixelMeansMatchTheIrradianceIntegral) {
                 normalize(xyz_of(cam.lower_left) + xyz_of(cam.du) * fx + xyz_of(cam.dv) * fy);
             float3 o = xyz_of(cam.origin);
             Hit h;
-            bvh_intersect(g.bvh.nodes.data(), g.bvh.prim_index.data(), g.prims.data(), o, d, 0,
+            bvh_intersect(g.bvh.nodes.data(), g.bvh.leaf_blocks.data(), g.prims.data(), o, d, 0,
                           FLT_INF, 0, &h);
             if (h.prim < 0 || g.prims[size_t(h.prim)].light >= 0) {
               sees_light = true;

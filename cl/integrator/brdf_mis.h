@@ -250,13 +250,13 @@ INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls,
   float3 o = xyz_of(it.origin), d = xyz_of(it.dir);
   Hit h;
   if (it.extra.z == (float)BRDF_ITEM_LIGHT) {
-    if (bvh_intersect(sc->nodes, sc->prim_index, sc->prims, o, d, 0.0f, it.origin.w, 1, &h) >= 0)
+    if (bvh_intersect(sc->nodes, sc->leaf_blocks, sc->prims, o, d, 0.0f, it.origin.w, 1, &h) >= 0)
       item->value = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
     return;
   }
   float4 zero = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
   if (!(it.origin.w > 0.0f) ||
-      bvh_intersect(sc->nodes, sc->prim_index, sc->prims, o, d, 0.0f, FLT_INF, 0, &h) < 0 ||
+      bvh_intersect(sc->nodes, sc->leaf_blocks, sc->prims, o, d, 0.0f, FLT_INF, 0, &h) < 0 ||
       sc->prims[h.prim].light < 0) {
     item->value = zero;
     return;

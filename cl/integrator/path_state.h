@@ -54,7 +54,7 @@
 // The scene's buffers, likewise: X(element type, name), read-only on the device.
 #define SCENE_BUFFERS(X)                                                                           \
   X(BvhNode, nodes)                                                                                \
-  X(int, prim_index)                                                                               \
+  X(LeafBlock, leaf_blocks)                                                                        \
   X(Primitive, prims)                                                                              \
   X(Material, materials)                                                                           \
   /* three unit vertex normals per smooth triangle (Primitive.normals, cl/geometry.h) */            \

@@ -4,14 +4,14 @@
 // deterministic, however many shadow rays a path has.
 #include "geometry.h"
 
-__kernel void intersect_shadow(__global const BvhNode* nodes, __global const int* prim_index,
+__kernel void intersect_shadow(__global const BvhNode* nodes, __global const LeafBlock* leaf_blocks,
                                __global const Primitive* prims, __global ShadowItem* shadow_items,
                                int count) {
   int i = get_global_id(0);
   if (i >= count) return;
   ShadowItem s = shadow_items[i];
   Hit h;
-  if (bvh_intersect(nodes, prim_index, prims, s.origin.xyz, s.dir.xyz, 0.0f, s.origin.w, 1, &h) >= 0)
+  if (bvh_intersect(nodes, leaf_blocks, prims, s.origin.xyz, s.dir.xyz, 0.0f, s.origin.w, 1, &h) >= 0)
     shadow_items[i].contribution = (float4)(0.0f);
 }
 

@@ -107,7 +107,7 @@ void set_lane(BvhNode& n, int lane, const RTCBounds& b, int code) {
 }
 
 BvhNode empty_node() {
-  BvhNode n;
+  BvhNode n{};
   for (int lane = 0; lane < 4; ++lane)
     set_lane(n, lane, empty_bounds(), BVH_EMPTY);
   return n;
@@ -129,14 +129,30 @@ struct Flattener {
     return b;
   }
 
+  LeafBlock block(const unsigned* ids, int count) const {
+    LeafBlock b{};
+    b.prim = make_int4(-1, -1, -1, -1);
+    float* f[9] = {&b.v0_x.x, &b.v0_y.x, &b.v0_z.x, &b.e1_x.x, &b.e1_y.x,
+                   &b.e1_z.x, &b.e2_x.x, &b.e2_y.x, &b.e2_z.x};
+    for (int lane = 0; lane < count; ++lane) {
+      const Primitive& p = prims[ids[lane]];
+      (&b.prim.x)[lane] = p.type == PRIM_TRIANGLE ? int(ids[lane]) : -2 - int(ids[lane]);
+      if (p.type != PRIM_TRIANGLE) continue;
+      const float v[9] = {p.v0.x, p.v0.y, p.v0.z, p.e1.x, p.e1.y, p.e1.z, p.e2.x, p.e2.y, p.e2.z};
+      for (int k = 0; k < 9; ++k)
+        f[k][lane] = v[k];
+    }
+    return b;
+  }
+
   // A leaf's code; leaves over BVH_MAX_LEAF primitives (Embree makes them only at its depth limit)
   // become a small subtree of nodes.
   int leaf(const unsigned* ids, int count, int depth) {
     if (count <= BVH_MAX_LEAF) {
-      int first = int(out.prim_index.size());
-      for (int i = 0; i < count; ++i)
-        out.prim_index.push_back(int(ids[i]));
-      return bvh_leaf_code(first, count);
+      int first = int(out.leaf_blocks.size());
+      for (int i = 0; i < count; i += 4)
+        out.leaf_blocks.push_back(block(ids + i, std::min(4, count - i)));
+      return bvh_leaf_code(first, int(out.leaf_blocks.size()) - first);
     }
     int at = int(out.nodes.size());
     out.nodes.push_back(empty_node());
@@ -248,9 +264,12 @@ Bvh build_bvh(const std::vector<Primitive>& prims) {
   args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
   args.maxBranchingFactor = 4;
   args.maxDepth = BVH_MAX_DEPTH - 4; // headroom for splitting oversized leaves
-  args.sahBlockSize = 1;
+  // Leaves are tested four primitives at a time (LeafBlock): SAH counts their cost in blocks of
+  // 4, and leaves of up to 8 fill blocks with 3.0 triangles on average (1.26 with leaves of 1-4
+  // costed per primitive): 11 MB of blocks for 200k triangles instead of 25 MB.
+  args.sahBlockSize = 4;
   args.minLeafSize = 1;
-  args.maxLeafSize = 4;
+  args.maxLeafSize = 8;
   args.traversalCost = 1.0f;
   args.intersectionCost = 1.0f;
   args.bvh = bvh;
@@ -269,7 +288,7 @@ Bvh build_bvh(const std::vector<Primitive>& prims) {
     throw std::runtime_error("rtcBuildBVH failed");
   }
   out.nodes.reserve(prims.size() / 2 + 1);
-  out.prim_index.reserve(prims.size());
+  out.leaf_blocks.reserve(prims.size() / 2 + 1);
   Flattener f{prims, out};
   if (root_node->leaf) { // the root is always a node: wrap a lone leaf
     out.nodes.push_back(empty_node());

@@ -13,9 +13,9 @@
 namespace canopy {
 
 struct Bvh {
-  std::vector<BvhNode> nodes;  // nodes[0] is the root
-  std::vector<int> prim_index; // leaf slots -> primitive index
-  int depth = 0;               // node levels on the longest path (<= BVH_MAX_DEPTH)
+  std::vector<BvhNode> nodes;         // nodes[0] is the root
+  std::vector<LeafBlock> leaf_blocks; // the leaves' primitives, in leaf order (cl/types.h)
+  int depth = 0;                      // node levels on the longest path (<= BVH_MAX_DEPTH)
 };
 
 struct SceneGeometry {

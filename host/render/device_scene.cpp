@@ -36,7 +36,7 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
                                 int emission_exponent, const Medium& medium) {
   DeviceScene d;
   d.nodes = upload_buffer(ctx, geometry.bvh.nodes);
-  d.prim_index = upload_buffer(ctx, geometry.bvh.prim_index);
+  d.leaf_blocks = upload_buffer(ctx, geometry.bvh.leaf_blocks);
   d.prims = upload_buffer(ctx, geometry.prims);
   d.materials = upload_buffer(ctx, materials);
   d.shading_normals = upload_buffer(ctx, geometry.shading_normals); // one element when empty

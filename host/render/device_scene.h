@@ -26,7 +26,7 @@ cl::Buffer upload_buffer(const cl::Context& ctx, const std::vector<T>& v,
 
 struct DeviceScene {
 #define CANOPY_DEVICE_SCENE_BUFFER(T, name) cl::Buffer name;
-  SCENE_BUFFERS(CANOPY_DEVICE_SCENE_BUFFER) // nodes, prim_index, prims, materials, normals, medium
+  SCENE_BUFFERS(CANOPY_DEVICE_SCENE_BUFFER) // nodes, leaf_blocks, prims, materials, normals, medium
 #undef CANOPY_DEVICE_SCENE_BUFFER
   cl::Buffer lights;
   cl::Buffer power_pmf, alias_prob, alias_index, lt_nodes, lt_children, lt_leaf_lights, lt_trails;

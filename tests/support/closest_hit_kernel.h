@@ -21,7 +21,7 @@ public:
     std::iota(queue.begin(), queue.end(), 0);
     const cl::Context& ctx = rt.context();
     args_.set("nodes", upload_buffer(ctx, bvh.nodes));
-    args_.set("prim_index", upload_buffer(ctx, bvh.prim_index));
+    args_.set("leaf_blocks", upload_buffer(ctx, bvh.leaf_blocks));
     args_.set("prims", upload_buffer(ctx, prims));
     args_.set("queue", upload_buffer(ctx, queue));
     args_.set("count", cl_int(count_));

@@ -76,4 +76,34 @@ inline Rays make_rays(const std::vector<Primitive>& prims, int count = 100000) {
   return r;
 }
 
+// Shadow segments (o.w: the segment's length): from random points on random triangles, lifted
+// 1e-4 off the surface towards the target, to random points in a box around the mesh (even i) or
+// to random points on other triangles, ending 1e-4 short of them (odd i); some are occluded, some
+// not.
+inline Rays make_shadow_rays(const std::vector<Primitive>& prims, int count = 100000) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f), pos(-3.0f, 3.0f);
+  std::uniform_int_distribution<size_t> pick(0, prims.size() - 1);
+  auto surface_point = [&](const Primitive& p) {
+    float a = u(rng), b = u(rng);
+    if (a + b > 1.0f) a = 1.0f - a, b = 1.0f - b;
+    return xyz_of(p.v0) + xyz_of(p.e1) * a + xyz_of(p.e2) * b;
+  };
+  Rays r;
+  for (int i = 0; i < count; ++i) {
+    const Primitive& from = prims[pick(rng)];
+    float3 o = surface_point(from);
+    float3 target =
+        i % 2 == 0 ? make_float3(pos(rng), pos(rng), pos(rng)) : surface_point(prims[pick(rng)]);
+    float3 n = normalize(cross(xyz_of(from.e1), xyz_of(from.e2)));
+    o = o + n * (dot(n, target - o) >= 0.0f ? 1e-4f : -1e-4f);
+    float3 to = target - o;
+    float dist = length(to);
+    float tmax = i % 2 == 0 ? dist : dist - 1e-4f;
+    r.o.push_back(f4_from3(o, tmax));
+    r.d.push_back(f4_from3(to * (1.0f / dist), 0.0f));
+  }
+  return r;
+}
+
 } // namespace canopy::testing
