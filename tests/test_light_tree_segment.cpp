@@ -362,6 +362,7 @@ TEST(LightTreeSegment, CappedSegmentCutPmfIsTheSamplingFrequency) {
   ls.max_cut = 64;
   const uint cap = light_sampler_segment_budget(ls.max_cut);
   ASSERT_EQ(cap, LT_SEGMENT_MAX_CUT);
+  ASSERT_LT(cap, 64u);
   EXPECT_EQ(light_sampler_segment_budget(2u), 2u); // a smaller max_cut still binds
   EXPECT_EQ(light_sampler_segment_budget(LT_BUDGET_UNLIMITED), LT_BUDGET_UNLIMITED); // exhaustive
   std::vector<LtQuery> segs = random_segments(lights, 4, 52); // short, long, through, inside

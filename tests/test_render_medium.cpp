@@ -456,19 +456,20 @@ FogScene unbounded_setup() {
   return s;
 }
 
-// c. (a) with each light replaced by four, spread outwards from the frame, and tree-split splitting
-// every cluster it may (threshold 1): the segments' cuts hit their cap (LT_SEGMENT_MAX_CUT, four
-// lights of twelve), so the pixel means check the capped cut and the one-sample choice of the
-// equiangular or free-flight point per light (volume_light.h) against the quadrature.
+// c. (a) with each light replaced by eight, spread outwards from the frame, and tree-split
+// splitting every cluster it may (threshold 1): the segments' cuts hit their cap
+// (LT_SEGMENT_MAX_CUT, 16 lights of 24), so the pixel means check the capped cut and the
+// one-sample choice of the equiangular or free-flight point per light (volume_light.h) against
+// the quadrature.
 FogScene many_lights_setup() {
   FogScene s = unbounded_setup();
   s.name = "many-lights";
   s.split_threshold = 1.0f;
   std::vector<PointL> lights;
   for (const PointL& l : s.lights)
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < 8; ++k) {
       V3 out = l.p - V3{0.2, 0.2, l.p.z};
-      lights.push_back({l.p + out * (0.15 * k), {0.4 * l.I[0], 0.4 * l.I[1], 0.4 * l.I[2]}});
+      lights.push_back({l.p + out * (0.08 * k), {0.2 * l.I[0], 0.2 * l.I[1], 0.2 * l.I[2]}});
     }
   s.lights = lights;
   return s;

@@ -35,12 +35,12 @@ typedef struct LightSamplerCtx {
 // surface measure decides the splits of a segment's cut too). A segment that passes through a
 // cluster's sphere always splits it (the measure at its closest point is 0 there), so with the
 // shading point's budget most segments near a light set split down to max_cut lights (19.7 shadow
-// rays per segment on spiral-fog at threshold 0.85, against 1.2 without splitting). Measured on
-// spiral-fog (docs/performance.md, "Splitting in media"), the root's split (one pick in each of its
-// lanes) removed most of the segments' light-selection variance, and the splits below it added
-// shadow rays at a cost well above the variance they removed. A segment's cut is so capped at
-// LT_SEGMENT_MAX_CUT lights; the exhaustive sampler's unlimited budget is kept.
-#define LT_SEGMENT_MAX_CUT 4u
+// rays per segment on spiral-fog at threshold 0.85, 40.3 on city-fog, against 1.2 without
+// splitting). Capping a segment's cut at LT_SEGMENT_MAX_CUT lights: 4 was the best on spiral-fog's
+// full paths and 16 on its direct light, within 10% of each other on city-fog; 16 is the
+// cap at which splitting stays at least as efficient as before everywhere (docs/performance.md,
+// "Splitting in media"). The exhaustive sampler's unlimited budget is kept.
+#define LT_SEGMENT_MAX_CUT 16u
 INLINE uint light_sampler_segment_budget(uint max_cut) {
   return max_cut >= LT_BUDGET_UNLIMITED || max_cut < LT_SEGMENT_MAX_CUT ? max_cut
                                                                         : LT_SEGMENT_MAX_CUT;
