@@ -37,9 +37,10 @@ typedef struct LightSamplerCtx {
 // shading point's budget most segments near a light set split down to max_cut lights (19.7 shadow
 // rays per segment on spiral-fog at threshold 0.85, 40.3 on city-fog, against 1.2 without
 // splitting). Capping a segment's cut at LT_SEGMENT_MAX_CUT lights: 4 was the best on spiral-fog's
-// full paths and 16 on its direct light, within 10% of each other on city-fog; 16 is the
-// cap at which splitting stays at least as efficient as before everywhere (docs/performance.md,
-// "Splitting in media"). The exhaustive sampler's unlimited budget is kept.
+// full paths and 16 on its direct light, within 10% of each other on city-fog; with 16 tree-split
+// is at least as efficient as tree on spiral-fog's direct light and on city-fog (with 4 it lost
+// spiral-fog's direct light to tree; docs/performance.md, "Splitting in media"). The exhaustive
+// sampler's unlimited budget is kept.
 #define LT_SEGMENT_MAX_CUT 16u
 INLINE uint light_sampler_segment_budget(uint max_cut) {
   return max_cut >= LT_BUDGET_UNLIMITED || max_cut < LT_SEGMENT_MAX_CUT ? max_cut
