@@ -372,7 +372,7 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
     for (int i = 0; i < kPaths; ++i) {
       int path = queue[size_t(i)], roots = ref_counts[size_t(i)].y;
       if (scene_.has_medium && ref.seg_o[size_t(path)].w >= 0.0f) {
-        items.push_back(light_sampler_root(&ls, path | SPLIT_SEGMENT));
+        items.push_back(volume_segment_root(&ls, path));
         roots -= 1;
       }
       if (roots) items.push_back(light_sampler_root(&ls, path));

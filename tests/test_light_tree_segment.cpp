@@ -344,6 +344,65 @@ TEST(LightTreeSegment, ChiSquareOfTreePicks) {
   }
 }
 
+// A medium segment's cut is capped at LT_SEGMENT_MAX_CUT lights (light_sampler.h): under
+// splitting that would take every cluster (threshold 1, max_cut 64), each segment's cut holds at
+// most the cap, the light sampler's pmf of a segment query (what MIS of phase-function rays uses)
+// is the pmf of the capped cut, and it equals the sampling frequency of each light (chi-square
+// over the lights, counts of picks over many cuts against pmf x cuts).
+TEST(LightTreeSegment, CappedSegmentCutPmfIsTheSamplingFrequency) {
+  std::vector<Light> lights = segment_lights(1200, 300, 51);
+  LightTree tree = build_light_tree(lights);
+  LtTree t = tree.view(lights.data());
+  LightSamplerCtx ls{};
+  ls.kind = SAMPLER_TREE_SPLIT;
+  ls.light_count = int(lights.size());
+  ls.lights = lights.data();
+  ls.tree = t;
+  ls.threshold = 1.0f;
+  ls.max_cut = 64;
+  const uint cap = light_sampler_segment_budget(ls.max_cut);
+  ASSERT_EQ(cap, LT_SEGMENT_MAX_CUT);
+  ASSERT_LT(cap, 64u);
+  EXPECT_EQ(light_sampler_segment_budget(2u), 2u); // a smaller max_cut still binds
+  EXPECT_EQ(light_sampler_segment_budget(LT_BUDGET_UNLIMITED), LT_BUDGET_UNLIMITED); // exhaustive
+  std::vector<LtQuery> segs = random_segments(lights, 4, 52); // short, long, through, inside
+  for (size_t i = 0; i < segs.size(); ++i) {
+    const LtQuery& q = segs[i];
+    std::vector<double> prob(lights.size());
+    double cut = 0;
+    for (size_t l = 0; l < lights.size(); ++l) {
+      prob[l] = light_sampler_pmf_q(&ls, &q, int(l));
+      ASSERT_EQ(float(prob[l]), lt_pmf_split_q(&t, &q, int(l), ls.threshold, cap));
+      cut += prob[l];
+    }
+    const int m = 100000;
+    std::vector<std::vector<double>> part(2, std::vector<double>(lights.size(), 0.0));
+    std::vector<size_t> largest(2, 0);
+    tbb::parallel_for(0, 2, [&](int h) {
+      std::vector<LightPick> out;
+      for (int k = h; k < m; k += 2) {
+        Rng rng = make_rng(uint32_t(500 + i), uint32_t(k));
+        out.clear();
+        sample_tree_split_q(t, q, rng, ls.threshold, int(cap), out);
+        largest[size_t(h)] = std::max(largest[size_t(h)], out.size());
+        for (const LightPick& p : out)
+          part[size_t(h)][size_t(p.light)] += 1;
+      }
+    });
+    EXPECT_LE(std::max(largest[0], largest[1]), size_t(cap)) << "segment " << i;
+    EXPECT_GT(cut, 1.5) << "segment " << i; // the cut did split
+    std::vector<double> counts(lights.size()), p1(lights.size());
+    for (size_t l = 0; l < lights.size(); ++l) {
+      counts[l] = part[0][l] + part[1][l];
+      p1[l] = prob[l] / cut; // the cut's size is the same for every cut of q
+    }
+    int dof;
+    double z = chi2_score(counts, p1, double(m) * cut, &dof);
+    EXPECT_LT(z, 5.0) << "segment " << i << " dof " << dof;
+    EXPECT_GT(dof, 50) << "segment " << i;
+  }
+}
+
 namespace {
 // The single-scattering integral of a light over the segment, without transmittance: for a point
 // light of intensity I exactly I * (theta_b - theta_a) / D (Eq. 4, D the distance from the light

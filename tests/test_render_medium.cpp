@@ -73,6 +73,7 @@ struct FogScene {
   Rgb albedo;
   Rgb sigma_a, sigma_s;
   double g;
+  float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD; // tree-split's
   bool bounded = false;
   V3 bmin{0, 0, 0}, bmax{0, 0, 0};
   std::vector<PointL> lights;
@@ -335,6 +336,7 @@ Outcome render_and_compare(ClRuntime& rt, const FogScene& s, const std::string& 
 
   RendererOptions opt;
   opt.light_sampler = sampler;
+  opt.split_threshold = s.split_threshold;
   Renderer renderer(rt, scene, opt);
   RenderSettings rs;
   rs.spp = spp;
@@ -454,6 +456,25 @@ FogScene unbounded_setup() {
   return s;
 }
 
+// c. (a) with each light replaced by eight, spread outwards from the frame, and tree-split
+// splitting every cluster it may (threshold 1): the segments' cuts hit their cap
+// (LT_SEGMENT_MAX_CUT, 16 lights of 24), so the pixel means check the capped cut and the
+// one-sample choice of the equiangular or free-flight point per light (volume_light.h) against
+// the quadrature.
+FogScene many_lights_setup() {
+  FogScene s = unbounded_setup();
+  s.name = "many-lights";
+  s.split_threshold = 1.0f;
+  std::vector<PointL> lights;
+  for (const PointL& l : s.lights)
+    for (int k = 0; k < 8; ++k) {
+      V3 out = l.p - V3{0.2, 0.2, l.p.z};
+      lights.push_back({l.p + out * (0.08 * k), {0.2 * l.I[0], 0.2 * l.I[1], 0.2 * l.I[2]}});
+    }
+  s.lights = lights;
+  return s;
+}
+
 // b. A box of medium the camera looks into from outside: wider than the view (so a light inside
 // it can be out of the frame), reaching below the plane (so the plane inside it is in the
 // medium); the plane is seen through it and beyond it. One light inside the box, one outside
@@ -521,8 +542,10 @@ TEST_P(MediumImage, PixelMeansMatchTheQuadrature) {
   // The bounded box's light legs bend the integrand where they cross the box's faces: more panels.
   if (which == 0)
     render_and_compare(rt, unbounded_setup(), sampler, 512, 8);
-  else
+  else if (which == 1)
     render_and_compare(rt, bounded_setup(), sampler, 512, 32);
+  else
+    render_and_compare(rt, many_lights_setup(), sampler, 512, 8);
 }
 
 INSTANTIATE_TEST_SUITE_P(UnboundedAndBounded, MediumImage,
@@ -530,11 +553,14 @@ INSTANTIATE_TEST_SUITE_P(UnboundedAndBounded, MediumImage,
                                            std::make_tuple(0, std::string("power")),
                                            std::make_tuple(0, std::string("tree")),
                                            std::make_tuple(1, std::string("tree-split")),
-                                           std::make_tuple(1, std::string("power"))),
+                                           std::make_tuple(1, std::string("power")),
+                                           std::make_tuple(2, std::string("tree-split"))),
                          [](const auto& p) {
-                           std::string name =
-                               std::string(std::get<0>(p.param) == 0 ? "unbounded_" : "bounded_") +
-                               std::get<1>(p.param);
+                           int which = std::get<0>(p.param);
+                           std::string name = std::string(which == 0   ? "unbounded_"
+                                                          : which == 1 ? "bounded_"
+                                                                       : "many_lights_") +
+                                              std::get<1>(p.param);
                            for (char& c : name)
                              if (c == '-') c = '_';
                            return name;

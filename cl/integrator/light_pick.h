@@ -13,9 +13,9 @@
 #include "path_state.h"
 #include "volume_light.h"
 
-// Shadow-item slots per split item: a split leaf stages one item per emitter (up to 4), two per
-// emitter for a medium segment (equiangular and free-flight points).
-#define LIGHT_PICK_SHADOW_SLOTS (HAS_MEDIUM ? 8 : 4)
+// Shadow-item slots per split item: a split leaf stages one item per emitter (up to 4), for a
+// medium segment too (one of its two points per light, volume_light.h).
+#define LIGHT_PICK_SHADOW_SLOTS 4
 
 // Samples a point on `light` (chosen with probability pmf) from the path's shading point and, if
 // it can contribute, writes the shadow item. Returns 1 if an item was written.
@@ -49,8 +49,8 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   return 1;
 }
 
-// The shadow items of `light`, picked with probability pmf for the item's context: one for a
-// shading point, up to two for a medium segment (volume_light.h).
+// The shadow item of `light`, picked with probability pmf for the item's context (a shading point
+// or a medium segment, volume_light.h); returns 1 if it was written.
 INLINE int light_pick_items(const LightSamplerCtx* ls, const SceneBuffers* sc,
                             const PathBuffers* pb, int path, int segment, int light, float pmf,
                             LtRng* rng, GLOBAL ShadowItem* out) {

@@ -2,17 +2,22 @@
 // Estevez & Kulla 2018, §5.2; equiangular sampling, Kulla & Fajardo 2012). The path's segment is
 // the part of this bounce's ray inside the medium (shade_volume.h writes it); light_pick ranks
 // light clusters for it with the segment importance (Eq. 7) and splits its cut with the surface
-// measure (§5.4), and for every light it picks stages up to two shadow items: the point of the
-// segment chosen by equiangular sampling towards the light, and the free-flight point of the
-// segment (the distance sample shade_volume drew), each MIS-weighted against the other technique
-// (power heuristic over their densities in t; both then sample the light from their point).
+// measure (§5.4), and for every light it picks stages one shadow item, at one of two points of
+// the segment: the point chosen by equiangular sampling towards the light, or the free-flight
+// point of the segment (the distance sample shade_volume drew). The point is chosen per light
+// (one-sample MIS, Veach 1997 §9.2.4: equiangular with probability VOLUME_EQ_SHARE when the
+// free-flight point falls on the segment) and the sample is weighted by the power heuristic over
+// the two techniques' densities in t times their choice probabilities; the light is then sampled
+// from that point. Both points for every light cost two shadow rays per light, and with a split
+// cut the free-flight point's rays bought little (docs/performance.md, "Splitting in media").
 //
 // A path that continues from the segment's free-flight point with a phase-function ray is a third
 // technique for the same integral (free-flight t, phase direction), which finds area lights: all
 // three are combined with the power heuristic over their densities in (t, direction), per light:
 //   equiangular:  pmf * pdf_eq(t) * pdf_light(w)      free flight:  pmf * pdf_ff(t) * pdf_light(w)
 //   phase:        pdf_ff(t) * p(w)
-// (volume_light_item for the light samples, volume_emission_weight for emitters found by phase
+// (each light technique's density times its choice probability, volume_technique_probs;
+// volume_light_item for the light samples, volume_emission_weight for emitters found by phase
 // rays). On a path's last vertex no phase ray leaves, and the light samples use two techniques.
 //
 // Compiles as OpenCL C and as C++.
@@ -38,6 +43,14 @@
 #define CANOPY_VOLUME_MIDPOINT 0 // 1: rank clusters by the surface importance at the midpoint
 #endif
 
+// The split-queue root item of a path's medium segment, with the segment's cut budget
+// (light_sampler_segment_budget, light_sampler.h).
+INLINE SplitItem volume_segment_root(const LightSamplerCtx* ls, int path) {
+  SplitItem it = light_sampler_root(ls, path | SPLIT_SEGMENT);
+  it.budget = light_sampler_segment_budget(ls->max_cut);
+  return it;
+}
+
 // The light-pick query of a segment (start o.xyz, length o.w, direction d.xyz): the segment itself
 // (Eq. 7), or under the ablation its midpoint as a point without a normal (the surface importance,
 // Eq. 3, without cos theta_i, with bounds grown by half the segment so that it stays
@@ -57,6 +70,23 @@ INLINE float power_heuristic3(float pa, float pb, float pc) {
   float m = fmax(pa, fmax(pb, pc));
   float a = pa / m, b = pb / m, c = pc / m;
   return a * a / (a * a + b * b + c * c);
+}
+
+// Probability of choosing the equiangular point for a picked light (when the free-flight point
+// falls on the segment; always, when it does not). Equiangular sampling is the better technique
+// near the light (exact in t for point lights), the free-flight point where transmittance along
+// the segment dominates. An even choice at most doubles a sample's weight; 0.9 was 4% better on
+// spiral-fog but up to ten times the weight of a free-flight sample made the estimate heavy-tailed
+// where transmittance matters (a light outside a box of medium: tests/test_render_medium.cpp).
+#define VOLUME_EQ_SHARE 0.5f
+
+// The two light techniques' choice probabilities on a segment of length len: (equiangular, free
+// flight). The free-flight point is on the segment with probability 1 - survival(len) and is then
+// taken with probability 1 - VOLUME_EQ_SHARE; otherwise the equiangular point is. The effective
+// densities (probability times density in t) give each sample's one-sample MIS weight.
+INLINE float2 volume_technique_probs(const Medium* m, float len) {
+  float c_ff = 1.0f - VOLUME_EQ_SHARE;
+  return make_float2(1.0f - c_ff * (1.0f - medium_survival(m, len)), c_ff);
 }
 
 // Where equiangular sampling aims for a light: its position (point, spot; exact) or the centre of
@@ -82,9 +112,10 @@ INLINE float3 volume_transmittance(const SceneBuffers* sc, float3 o, float3 d, f
 // rule does not depend on the scene's units or brightness.
 #define VOLUME_ROULETTE_WEIGHT 0.1f
 
-// The shadow item of a light sampled from the segment's point at distance t, chosen with density
-// p_t by one technique in t (p_other: the other's density there): beta Tr(t) sigma_s p(theta) Li
-// Tr(leg) w / (p_t pmf pdf(wi)), w the power heuristic against the other technique and, when
+// The shadow item of a light sampled from the segment's point at distance t, chosen with
+// effective density p_t (choice probability times density in t) by one technique (p_other: the
+// other's there): beta Tr(t) sigma_s p(theta) Li Tr(leg) w / (p_t pmf pdf(wi)), w the power
+// heuristic against the other technique and, when
 // `phase_mis`, against the phase-function technique (then the roulette above, with u_rr).
 // Returns 1 if an item was written.
 INLINE int volume_light_item(const Medium* m, const LightSamplerCtx* ls, int path, float3 a,
@@ -121,13 +152,12 @@ INLINE int volume_light_item(const Medium* m, const LightSamplerCtx* ls, int pat
   return 1;
 }
 
-// The (up to two) shadow items of `light`, picked with probability pmf for the segment of `path`.
+// The shadow item (at most one) of `light`, picked with probability pmf for the segment of `path`.
 INLINE int volume_shadow_items(const LightSamplerCtx* ls, const SceneBuffers* sc,
                                const PathBuffers* pb, int path, int light, float pmf, LtRng* rng,
                                GLOBAL ShadowItem* out) {
-  float u0 = lt_rng_next(rng), u1 = lt_rng_next(rng), u2 = lt_rng_next(rng);
-  float u3 = lt_rng_next(rng), u4 = lt_rng_next(rng);
-  float u5 = lt_rng_next(rng), u6 = lt_rng_next(rng);
+  float u_pick = lt_rng_next(rng), u0 = lt_rng_next(rng);
+  float u1 = lt_rng_next(rng), u2 = lt_rng_next(rng), u_rr = lt_rng_next(rng);
   if (!(pmf > 0.0f)) return 0;
   Medium m = sc->medium[0];
   float4 so = pb->seg_o[path];
@@ -137,27 +167,28 @@ INLINE int volume_shadow_items(const LightSamplerCtx* ls, const SceneBuffers* sc
   float len = so.w, t_free = sd.w;
   int phase_mis = pb->seg_phase[path] > 0.0f;
   float3 c = light_center(&ls->lights[light]);
-  int n = 0;
+  float2 pc = volume_technique_probs(&m, len);
+  if (t_free < len && u_pick >= VOLUME_EQ_SHARE) {
+    // The free-flight point.
+    float p_ff = medium_distance_pdf(&m, t_free);
+    if (!(p_ff > 0.0f)) return 0;
+    return volume_light_item(&m, ls, path, a, d, t_free, pc.y * p_ff,
+                             pc.x * equiangular_pdf(a, d, len, c, t_free), phase_mis, beta, light,
+                             pmf, u1, u2, u_rr, out);
+  }
   // Equiangular sampling towards the light (exact for point lights: pdf ~ 1 / |x(t) - c|^2).
   float p_eq = 0.0f;
   float t_eq = equiangular_sample(a, d, len, c, u0, &p_eq);
-  if (p_eq > 0.0f)
-    n += volume_light_item(&m, ls, path, a, d, t_eq, p_eq, medium_distance_pdf(&m, t_eq), phase_mis,
-                           beta, light, pmf, u1, u2, u5, out + n);
-  // The free-flight point, if it falls on the segment.
-  if (t_free < len) {
-    float p_ff = medium_distance_pdf(&m, t_free);
-    if (p_ff > 0.0f)
-      n +=
-          volume_light_item(&m, ls, path, a, d, t_free, p_ff, equiangular_pdf(a, d, len, c, t_free),
-                            phase_mis, beta, light, pmf, u3, u4, u6, out + n);
-  }
-  return n;
+  if (!(p_eq > 0.0f)) return 0;
+  return volume_light_item(&m, ls, path, a, d, t_eq, pc.x * p_eq,
+                           pc.y * medium_distance_pdf(&m, t_eq), phase_mis, beta, light, pmf, u1,
+                           u2, u_rr, out);
 }
 
 // MIS weight of the emission that a phase-function ray from the path's last medium vertex (at
 // distance t along its segment, shade_P.xyz, phase density shade_P.w) finds at point y of `light`:
-// the phase technique against the segment's two light-sampling techniques for that light.
+// the phase technique against the segment's two light-sampling techniques for that light (their
+// densities times their choice probabilities, as in volume_shadow_items).
 INLINE float volume_emission_weight(const LightSamplerCtx* ls, const SceneBuffers* sc,
                                     const PathBuffers* pb, int path, int light, float3 y) {
   Medium m = sc->medium[0];
@@ -170,7 +201,8 @@ INLINE float volume_emission_weight(const LightSamplerCtx* ls, const SceneBuffer
   float p_light = light_sampler_pmf_q(ls, &q, light) * light_pdf(&ls->lights[light], xyz_of(x), y);
   float3 c = light_center(&ls->lights[light]);
   float p_eq = equiangular_pdf(xyz_of(so), xyz_of(sd), so.w, c, t);
-  return power_heuristic3(p_ff * x.w, p_eq * p_light, p_ff * p_light);
+  float2 pc = volume_technique_probs(&m, so.w);
+  return power_heuristic3(p_ff * x.w, pc.x * p_eq * p_light, pc.y * p_ff * p_light);
 }
 
 #endif // CANOPY_INTEGRATOR_VOLUME_LIGHT_H

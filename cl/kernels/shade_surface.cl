@@ -40,7 +40,9 @@ __kernel void scatter_shade(__global const int* queue, int count, SCAN_PARAMS
     // The segment's root first, then the surface point's: a path's items stay together.
     if (HAS_MEDIUM && seg_o[path].w >= 0.0f) {
       it.path = path | SPLIT_SEGMENT;
+      it.budget = light_sampler_segment_budget(max_cut);
       split_out[pos.y++] = it;
+      it.budget = max_cut;
       roots -= 1;
     }
     if (roots) {

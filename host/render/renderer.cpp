@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include "integrator/brdf_mis.h"
+#include "integrator/light_pick.h"
 #include "render/camera.h"
 #include "render/memory_budget.h"
 
@@ -174,9 +175,9 @@ Film Renderer::render(const RenderSettings& settings) {
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
   // Every path's cut has at most max_cut items in any pass, so waves of
   // split_queue_items / max_cut paths bound the split queue. With a medium a path has two cuts (its
-  // segment's and its surface point's), and a split item stages up to 8 shadow items, not 4.
+  // segment's and its surface point's).
   const bool medium = volume_stages_;
-  const size_t roots = medium ? 2 : 1, shadow_slots = medium ? 8 : 4;
+  const size_t roots = medium ? 2 : 1, shadow_slots = LIGHT_PICK_SHADOW_SLOTS;
   size_t wave = std::max<size_t>(
       1, std::min(settings.wave_size, options_.split_queue_items / (roots * sampler_.max_cut)));
   const size_t W = size_t(std::min<uint64_t>(total, wave));
@@ -188,7 +189,7 @@ Film Renderer::render(const RenderSettings& settings) {
                 {"film_sumsq", uint64_t(npix) * sizeof(double4)},
                 {"film_counts", uint64_t(npix) * sizeof(double4)},
                 {"shadow_stage", shadow_slots * uint64_t(split_cap) * sizeof(ShadowItem)},
-                {"shadow_items", (medium ? 2 : 1) * uint64_t(split_cap) * sizeof(ShadowItem)},
+                {"shadow_items", uint64_t(split_cap) * sizeof(ShadowItem)},
                 {"child_stage", 4 * uint64_t(split_cap) * sizeof(SplitItem)},
                 {"brdf_stage", uint64_t(brdf_stages_ ? W : 1) * BRDF_MAX_BATCH * sizeof(BrdfItem)}},
                {{"film (host copy)", uint64_t(npix) * 3 * sizeof(double4)},
@@ -223,9 +224,8 @@ Film Renderer::render(const RenderSettings& settings) {
   cl::Buffer split_b = device_buffer(ctx, split_cap * sizeof(SplitItem));
   buffer("child_stage", 4 * split_cap * sizeof(SplitItem));
   buffer("shadow_stage", shadow_slots * split_cap * sizeof(ShadowItem));
-  // A pass's shadow queue: one item per light in the cuts (at most split_cap of them), two for a
-  // medium segment's (equiangular and free-flight points).
-  buffer("shadow_items", (medium ? 2 : 1) * split_cap * sizeof(ShadowItem));
+  // A pass's shadow queue: at most one item per light in the cuts (at most split_cap of them).
+  buffer("shadow_items", split_cap * sizeof(ShadowItem));
   cl::Buffer counts_pick = buffer("counts_pick", split_cap * sizeof(cl_int2));
   // BRDF-oriented sampling (brdf_mis.cl): each path's cut, one round's staged and compacted items.
   const size_t brdf_paths = brdf_stages_ ? W : 1;
