@@ -173,15 +173,19 @@ Film Renderer::render(const RenderSettings& settings) {
   const int width = scene_.film.width, height = scene_.film.height;
   const int npix = width * height;
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
-  // Every path's cut has at most max_cut items in any pass, so waves of
-  // split_queue_items / max_cut paths bound the split queue. With a medium a path has two cuts (its
-  // segment's and its surface point's).
+  // A cut never holds more items in a pass than its budget, nor more than max_cut (every light, for
+  // the exhaustive sampler): a shading point's cut at most max_cut and, with a medium, its
+  // segment's at most the segment budget (light_sampler_segment_budget). Waves of
+  // split_queue_items / (both bounds) paths bound the split queue.
   const bool medium = volume_stages_;
-  const size_t roots = medium ? 2 : 1, shadow_slots = LIGHT_PICK_SHADOW_SLOTS;
-  size_t wave = std::max<size_t>(
-      1, std::min(settings.wave_size, options_.split_queue_items / (roots * sampler_.max_cut)));
+  const size_t shadow_slots = LIGHT_PICK_SHADOW_SLOTS;
+  const size_t segment_items =
+      std::min<size_t>(sampler_.max_cut, light_sampler_segment_budget(sampler_.root_budget()));
+  const size_t cut_items = size_t(sampler_.max_cut) + (medium ? segment_items : 0u);
+  size_t wave =
+      std::max<size_t>(1, std::min(settings.wave_size, options_.split_queue_items / cut_items));
   const size_t W = size_t(std::min<uint64_t>(total, wave));
-  const size_t split_cap = W * roots * sampler_.max_cut;
+  const size_t split_cap = W * cut_items;
   const int max_depth = scene_.integrator.max_depth;
   // Fail before any work if the film or the wave does not fit (docs/limits.md).
   check_memory(rt_.device(),
