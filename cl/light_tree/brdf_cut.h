@@ -267,25 +267,41 @@ INLINE int lt_brdf_cut_find(GLOBAL const float2* cut, int n, int code) {
   return -1;
 }
 
-// Probability that lt_brdf_pick produces `light` (the cut is P's): follow the light's bit-trail
-// from the root to the cut entry that holds it, then the descent's lane probabilities below it.
+// The entry of P's cut that holds `light`, found by following the light's bit-trail from the root:
+// its index (-1: the cut has none), and in *code and *trail the entry's code and the trail below
+// it; *descends is 0 when the entry is the emitter itself (a split leaf's), with nothing below.
+INLINE int lt_brdf_cut_entry(const LtTree* t, GLOBAL const float2* cut, int n, int light, int* code,
+                             uint* trail, int* descends) {
+  uint tr = t->trails[light];
+  int c = 0;
+  *descends = 1;
+  for (;;) {
+    int j = lt_brdf_cut_find(cut, n, c);
+    if (j >= 0 || c == LT_EMPTY) {
+      *code = c;
+      *trail = tr;
+      return j;
+    }
+    int lane = (int)(tr & 3u);
+    tr = tr >> 2;
+    if (c < 0) { // a split leaf: the emitter's own entry, if P's cut kept it
+      *descends = 0;
+      return lt_brdf_cut_find(cut, n, lt_leaf_code(lt_leaf_first(c) + lane, 1));
+    }
+    c = i4_get(t->children[c], lane);
+  }
+}
+
+// Probability that lt_brdf_pick produces `light` (the cut is P's): the probability of the cut
+// entry that holds it, times the descent's lane probabilities below it.
 INLINE float lt_brdf_pmf(const LtTree* t, GLOBAL const float2* cut, int n, float3 P, float3 Ng,
                          const CapLobe* lobe, int light) {
-  uint trail = t->trails[light];
-  int code = 0;
-  for (;;) {
-    int j = lt_brdf_cut_find(cut, n, code);
-    if (j >= 0)
-      return lt_brdf_entry_prob(cut, n, j) * lt_brdf_pmf_below(t, code, trail, P, Ng, lobe);
-    if (code == LT_EMPTY) return 0.0f;
-    int lane = (int)(trail & 3u);
-    trail = trail >> 2;
-    if (code < 0) { // a split leaf: the emitter's own entry, if P's cut kept it
-      j = lt_brdf_cut_find(cut, n, lt_leaf_code(lt_leaf_first(code) + lane, 1));
-      return j >= 0 ? lt_brdf_entry_prob(cut, n, j) : 0.0f;
-    }
-    code = i4_get(t->children[code], lane);
-  }
+  int code, descends;
+  uint trail;
+  int j = lt_brdf_cut_entry(t, cut, n, light, &code, &trail, &descends);
+  if (j < 0) return 0.0f;
+  float p = lt_brdf_entry_prob(cut, n, j);
+  return descends ? p * lt_brdf_pmf_below(t, code, trail, P, Ng, lobe) : p;
 }
 
 // A cheap stand-in for lt_brdf_pmf in MIS weights, which need only be some function of the
@@ -295,20 +311,12 @@ INLINE float lt_brdf_pmf(const LtTree* t, GLOBAL const float2* cut, int n, float
 // without the four cap integrals per level of the exact pmf.
 INLINE float lt_brdf_pmf_weight(const LtTree* t, GLOBAL const float2* cut, int n, float3 P,
                                 float3 Nq, int light) {
-  uint trail = t->trails[light];
-  int code = 0;
-  for (;;) {
-    int j = lt_brdf_cut_find(cut, n, code);
-    if (j >= 0) return lt_brdf_entry_prob(cut, n, j) * lt_pmf_below(t, code, P, Nq, trail);
-    if (code == LT_EMPTY) return 0.0f;
-    int lane = (int)(trail & 3u);
-    trail = trail >> 2;
-    if (code < 0) { // a split leaf: the emitter's own entry, if P's cut kept it
-      j = lt_brdf_cut_find(cut, n, lt_leaf_code(lt_leaf_first(code) + lane, 1));
-      return j >= 0 ? lt_brdf_entry_prob(cut, n, j) : 0.0f;
-    }
-    code = i4_get(t->children[code], lane);
-  }
+  int code, descends;
+  uint trail;
+  int j = lt_brdf_cut_entry(t, cut, n, light, &code, &trail, &descends);
+  if (j < 0) return 0.0f;
+  float p = lt_brdf_entry_prob(cut, n, j);
+  return descends ? p * lt_pmf_below(t, code, P, Nq, trail) : p;
 }
 
 #endif // CANOPY_LIGHT_TREE_BRDF_CUT_H
