@@ -37,15 +37,20 @@ void set_rate(benchmark::State& state, int64_t rays) {
   state.counters["triangles"] = double(fixture().prims.size());
 }
 
-void Intersect_OpenCL(benchmark::State& state) {
-  const size_t local = size_t(state.range(0));
+// An intersect kernel (tests/support) over the fixture's rays, work-groups of state.range(0).
+template <class Kernel>
+void run_opencl(benchmark::State& state, const char* source, const testing::Rays& rays) {
   IntersectFixture& f = fixture();
   ClRuntime rt;
-  cl::Program program = rt.build_program({"kernels/intersect_closest.cl"});
-  testing::ClosestHitKernel kernel(rt, program, f.bvh, f.prims, f.rays);
+  cl::Program program = rt.build_program({source});
+  Kernel kernel(rt, program, f.bvh, f.prims, rays);
   for (auto _ : state)
-    kernel.run(local);
+    kernel.run(size_t(state.range(0)));
   set_rate(state, int64_t(state.iterations()) * kRayCount);
+}
+
+void Intersect_OpenCL(benchmark::State& state) {
+  run_opencl<testing::ClosestHitKernel>(state, "kernels/intersect_closest.cl", fixture().rays);
 }
 
 void Intersect_Embree1(benchmark::State& state) {
@@ -102,14 +107,7 @@ void Intersect_Embree8(benchmark::State& state) {
 }
 
 void Occluded_OpenCL(benchmark::State& state) {
-  const size_t local = size_t(state.range(0));
-  IntersectFixture& f = fixture();
-  ClRuntime rt;
-  cl::Program program = rt.build_program({"kernels/intersect_shadow.cl"});
-  testing::ShadowKernel kernel(rt, program, f.bvh, f.prims, f.shadow_rays);
-  for (auto _ : state)
-    kernel.run(local);
-  set_rate(state, int64_t(state.iterations()) * kRayCount);
+  run_opencl<testing::ShadowKernel>(state, "kernels/intersect_shadow.cl", fixture().shadow_rays);
 }
 
 void Occluded_Embree1(benchmark::State& state) {
