@@ -149,6 +149,11 @@ canopy_cli_test(cli_converge_bad_nmax_suffix
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|brdf-mis/nmax=0"
   -DRC=2 "-DSTDERR=--samplers: 'brdf-mis/nmax=0': /nmax=N: N must be an integer in [1, 1024]"
   -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
+# "/maxcut=N" sets tree-split's cut cap (render --max-cut's range), refused before any render.
+canopy_cli_test(cli_converge_bad_maxcut_suffix
+  "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|tree-split/maxcut=x"
+  -DRC=2 "-DSTDERR=--samplers: 'tree-split/maxcut=x': /maxcut=N: N must be an integer in [1, 65536]"
+  -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_converge_bsdf_nomis
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|bsdf/nomis"
   -DRC=2 "-DSTDERR=--samplers: 'bsdf/nomis': /nomis does not apply to bsdf (BSDF sampling only: there is no light sample to combine with)"

@@ -66,6 +66,7 @@ struct SamplerConfig {
   // With a medium: "/midpoint" ranks light clusters for a ray segment by the surface importance
   // at its midpoint (the ablation of Conty Estevez & Kulla's segment importance, Eq. 7).
   bool volume_midpoint = false;
+  int max_cut = kDefaultMaxCut; // "/maxcut=N": tree-split's cut cap per shading point
 };
 
 constexpr std::string_view kNoOrientSuffix = "-noorient";
@@ -74,6 +75,7 @@ constexpr std::string_view kEqualSuffix = "equal";       // after a '/'
 constexpr std::string_view kMidpointSuffix = "midpoint"; // after a '/'
 constexpr std::string_view kSplitSuffix = "split=";      // after a '/', then the threshold
 constexpr std::string_view kNmaxSuffix = "nmax=";        // after a '/', then brdf-mis' N_max
+constexpr std::string_view kMaxCutSuffix = "maxcut=";    // after a '/', then max_cut
 constexpr float kMaxBrdfDelta = 1000.0f;                 // as `canopy render --brdf-delta`
 
 bool is_brdf_sampler(const std::string& sampler) {
@@ -142,8 +144,19 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
   c.brdf.n_max = scene.brdf_n_max;
   c.brdf.lambda = scene.brdf_lambda;
   c.brdf.adaptive = true;
+  c.max_cut = scene.max_cut;
   std::string spec = text;
-  bool equal = false, split_set = false, nmax_set = false;
+  bool equal = false, split_set = false, nmax_set = false, cut_set = false;
+  // The integer after "/name=", in [lo, hi].
+  auto suffix_int = [&](const std::string& suffix, std::string_view name, long lo, long hi) {
+    std::string t = suffix.substr(name.size());
+    char* end = nullptr;
+    long v = std::strtol(t.c_str(), &end, 10);
+    if (t.empty() || *end != '\0' || v < lo || v > hi)
+      throw SceneError(fmt::format("{}: '{}': /{}N: N must be an integer in [{}, {}]", option,
+                                   printable(text, 256), name, lo, hi));
+    return int(v);
+  };
   if (size_t slash = spec.find('/'); slash != std::string::npos) {
     std::stringstream suffixes(spec.substr(slash + 1));
     spec.resize(slash);
@@ -170,22 +183,20 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
         split_set = true;
       } else if (suffix.starts_with(kNmaxSuffix) && !nmax_set) {
         // "/nmax=N": the BRDF samplers' most BRDF-aware samples per glossy point (Eq. 9).
-        std::string t = suffix.substr(kNmaxSuffix.size());
-        char* end = nullptr;
-        long v = std::strtol(t.c_str(), &end, 10);
-        if (t.empty() || *end != '\0' || v < 1 || v > kMaxBrdfSamples)
-          throw SceneError(fmt::format("{}: '{}': /{}N: N must be an integer in [1, {}]", option,
-                                       printable(text, 256), kNmaxSuffix, kMaxBrdfSamples));
-        c.brdf.n_max = int(v);
+        c.brdf.n_max = suffix_int(suffix, kNmaxSuffix, 1, kMaxBrdfSamples);
         nmax_set = true;
+      } else if (suffix.starts_with(kMaxCutSuffix) && !cut_set) {
+        // "/maxcut=N": the most lights tree-split samples per shading point.
+        c.max_cut = suffix_int(suffix, kMaxCutSuffix, 1, kMaxMaxCut);
+        cut_set = true;
       } else {
         throw SceneError(fmt::format("{}: '{}': unknown or repeated suffix '/{}' (/{}: MIS off; "
                                      "/{}: brdf-mis with equal allocation; /{}: medium segments "
                                      "ranked at their midpoint; /{}T: split threshold T; "
-                                     "/{}N: brdf-mis' N_max)",
+                                     "/{}N: brdf-mis' N_max; /{}N: cut cap)",
                                      option, printable(text, 256), printable(suffix, 256),
                                      kNoMisSuffix, kEqualSuffix, kMidpointSuffix, kSplitSuffix,
-                                     kNmaxSuffix));
+                                     kNmaxSuffix, kMaxCutSuffix));
       }
     }
     if (!any)
@@ -237,11 +248,11 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
   return c;
 }
 
-RendererOptions renderer_options(const SamplerConfig& c, const Scene& base) {
+RendererOptions renderer_options(const SamplerConfig& c) {
   RendererOptions opt;
   opt.light_sampler = c.sampler;
   opt.split_threshold = c.threshold;
-  opt.max_cut = base.integrator.max_cut;
+  opt.max_cut = c.max_cut;
   opt.orientation_term = c.orientation;
   opt.mis = c.mis;
   opt.brdf = c.brdf;
@@ -455,7 +466,7 @@ void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, P
   SamplerConfig c = parse_config(a.reference_sampler, base.integrator, "--reference-sampler");
   Scene scene = base;
   scene.integrator.volume_importance = c.volume_midpoint ? "midpoint" : "segment";
-  Renderer r(rt, scene, renderer_options(c, base));
+  Renderer r(rt, scene, renderer_options(c));
   int total_spp = a.reference_spp;
   if (a.reference_time > 0.0) {
     // Warm-up (kernel builds), then the timing renders: the spp of the whole reference.
@@ -734,7 +745,7 @@ int run_converge(const ConvergeArgs& a) {
     scenes.back()->integrator.volume_importance =
         res.config.volume_midpoint ? "midpoint" : "segment";
     renderers.push_back(
-        std::make_unique<Renderer>(rt, *scenes.back(), renderer_options(res.config, base)));
+        std::make_unique<Renderer>(rt, *scenes.back(), renderer_options(res.config)));
     Renderer& renderer = *renderers.back();
     res.build_seconds = renderer.stats().build_seconds;
     res.light_tree_seconds = renderer.stats().light_tree_seconds;
@@ -958,7 +969,8 @@ CLI::App* add_converge_command(CLI::App& app, std::function<int()>& action) {
                   "brdf-mis:D and brdf-oriented:D set the BRDF split threshold delta D; "
                   "brdf-mis/equal allocates BRDF-aware samples equally (else adaptively); "
                   "/split=T sets the split threshold where :T means delta; /nmax=N the BRDF "
-                  "samplers' most BRDF-aware samples per glossy point")
+                  "samplers' most BRDF-aware samples per glossy point; /maxcut=N the most "
+                  "lights tree-split samples per shading point")
       ->capture_default_str();
   cmd->add_option("--budget", a->budget, "Render seconds per configuration (all points and seeds)")
       ->check(CLI::PositiveNumber)
