@@ -11,6 +11,7 @@ packages=(
   libopenimageio-dev openimageio-tools
   libtinyobjloader-dev nlohmann-json3-dev libcli11-dev libfmt-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  slurm-wlm munge
 )
 
 missing=()

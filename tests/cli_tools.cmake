@@ -4,6 +4,9 @@
 #   MODE=compare   EXE, OIIOTOOL, DIR: two tiny EXRs made with oiiotool; output, exit codes
 #   MODE=converge  EXE, SCENE, DIR: a 2-second converge run writes the CSVs and both plots; an
 #                  equal-time run (--equal-time, --max-depth 1) writes the statistics columns
+#   MODE=merge     EXE, SCENE, OTHER, LONG, DIR: `render --samples/--crop` and `merge` (issue 23):
+#                  ranges merge into one range, every inconsistent input is refused with one line;
+#                  progress in a log is whole lines (LONG: a scene that renders for > 1 s)
 
 if(NOT CMAKE_SCRIPT_MODE_FILE)
   # ------------------------------------------------------------------ registration
@@ -20,6 +23,14 @@ if(NOT CMAKE_SCRIPT_MODE_FILE)
             -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/data/tiny_converge.json
             -DDIR=${CMAKE_CURRENT_BINARY_DIR}/cli_converge -P ${CMAKE_CURRENT_LIST_FILE})
   set_tests_properties(cli_converge PROPERTIES LABELS cli TIMEOUT 600
+                       ENVIRONMENT CANOPY_KERNEL_WERROR=1)
+  add_test(NAME cli_merge
+    COMMAND ${CMAKE_COMMAND} -DMODE=merge -DEXE=$<TARGET_FILE:canopy>
+            -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/data/tiny_converge.json
+            -DOTHER=${CMAKE_CURRENT_SOURCE_DIR}/data/limits/tiny.json
+            -DLONG=${CMAKE_SOURCE_DIR}/scenes/default.json
+            -DDIR=${CMAKE_CURRENT_BINARY_DIR}/cli_merge -P ${CMAKE_CURRENT_LIST_FILE})
+  set_tests_properties(cli_merge PROPERTIES LABELS cli TIMEOUT 600
                        ENVIRONMENT CANOPY_KERNEL_WERROR=1)
   return()
 endif()
@@ -154,6 +165,72 @@ elseif(MODE STREQUAL "converge")
   expect_contains("${err}" "--samplers: unknown light sampler 'bogus'")
   run_canopy(2 converge "${SCENE}" --reference "${DIR}/ref.exr" --samplers power-noorient)
   expect_contains("${err}" "--samplers: 'power-noorient': -noorient applies to tree samplers only")
+elseif(MODE STREQUAL "merge")
+  # stderr is exactly one line
+  function(expect_one_line text)
+    string(REGEX REPLACE "\n$" "" body "${text}")
+    string(FIND "${body}" "\n" nl)
+    if(NOT nl EQUAL -1 OR body STREQUAL "")
+      message(FATAL_ERROR "expected exactly one line, got:\n${text}")
+    endif()
+  endfunction()
+  run_canopy(0 render "${SCENE}" --spp 4 --out "${DIR}/full.exr")
+  run_canopy(0 render "${SCENE}" --samples 0:1 --out "${DIR}/a.exr")
+  run_canopy(0 render "${SCENE}" --samples 1:4 --out "${DIR}/b.exr")
+  expect_contains("${err}" "32x24, 3 spp (samples 1:4)")
+  run_canopy(0 merge "${DIR}/m.exr" "${DIR}/a.exr" "${DIR}/b.exr")
+  expect_contains("${out}" "merged 2 images into ${DIR}/m.exr: 32x24, 4 samples per pixel (samples 0:4 of seed 1)")
+  run_canopy(0 compare "${DIR}/m.exr" "${DIR}/full.exr" --json)
+  # Equal up to float rounding of the means.
+  string(REGEX MATCH "\"max_abs_error\": ([^,]*)," m "${out}")
+  if(NOT CMAKE_MATCH_1 OR NOT CMAKE_MATCH_1 LESS 1e-6)
+    message(FATAL_ERROR "merged ranges differ from the one render:\n${out}")
+  endif()
+  # A merged image of one range is itself a partial render: it merges again.
+  run_canopy(0 render "${SCENE}" --samples 4:6 --crop 0,0,16,24 --out "${DIR}/c.exr")
+  expect_contains("${err}" "(samples 4:6), crop 0,0,16,24")
+  run_canopy(0 merge "${DIR}/m2.exr" "${DIR}/m.exr" "${DIR}/c.exr")
+  expect_contains("${out}" "6 samples per pixel")
+  expect_contains("${out}" "missing coverage: 384 of 768 pixels have fewer samples (as few as 4) than the most covered (6)")
+  # Refusals: exit 2, one line.
+  run_canopy(2 merge "${DIR}/x.exr" "${DIR}/m.exr" "${DIR}/a.exr")
+  expect_contains("${err}" "${DIR}/m.exr and ${DIR}/a.exr both hold samples [0, 1) of seed 1 for pixels [0, 32) x [0, 24)")
+  expect_one_line("${err}")
+  run_canopy(2 merge "${DIR}/x.exr" "${DIR}/a.exr" "${DIR}/missing.exr")
+  expect_contains("${err}" "${DIR}/missing.exr: no such file")
+  expect_one_line("${err}")
+  run_canopy(0 render "${OTHER}" --samples 1:2 --out "${DIR}/other.exr")
+  run_canopy(2 merge "${DIR}/x.exr" "${DIR}/a.exr" "${DIR}/other.exr")
+  expect_contains("${err}" "${DIR}/other.exr: rendered from scene ${OTHER}")
+  expect_one_line("${err}")
+  run_canopy(2 merge "${DIR}/x.exr" "${DIR}/a.exr" "${DIR}/m2.exr")
+  expect_contains("${err}" "${DIR}/m2.exr: not a Canopy render (no canopy:samples attribute")
+  expect_one_line("${err}")
+  run_canopy(2 merge "${DIR}/a.exr" "${DIR}/a.exr" "${DIR}/b.exr")
+  expect_contains("${err}" "${DIR}/a.exr: is both an input and the output")
+  run_canopy(2 render "${SCENE}" --samples 3:2 --out "${DIR}/y.exr")
+  expect_contains("${err}" "--samples: '3:2': want A:B with 0 <= A < B <= 16777216")
+  expect_one_line("${err}")
+  run_canopy(2 render "${SCENE}" --samples 0:2 --spp 2 --out "${DIR}/y.exr")
+  expect_contains("${err}" "--samples and --spp: give one")
+  run_canopy(2 render "${SCENE}" --crop 0,0,33,24 --out "${DIR}/y.exr")
+  expect_contains("${err}" "--crop: '0,0,33,24': want x0,y0,x1,y1 with 0 <= x0 < x1 <= 32 and 0 <= y0 < y1 <= 24 (the film)")
+  expect_one_line("${err}")
+  if(EXISTS "${DIR}/x.exr" OR EXISTS "${DIR}/y.exr")
+    message(FATAL_ERROR "a refused merge or render wrote its output")
+  endif()
+  # Progress in a log (stderr is a pipe here): whole lines, no carriage returns; none with --quiet.
+  run_canopy(0 render "${LONG}" --spp 32 --out "${DIR}/long.exr")
+  expect_contains("${err}" "canopy: 100% rendered, ")
+  string(FIND "${err}" "\r" cr)
+  if(NOT cr EQUAL -1)
+    message(FATAL_ERROR "progress wrote a carriage return into a log:\n${err}")
+  endif()
+  run_canopy(0 render "${LONG}" --spp 4 --quiet --out "${DIR}/long.exr")
+  string(FIND "${err}" "rendered, " p)
+  if(NOT p EQUAL -1)
+    message(FATAL_ERROR "--quiet still reports progress:\n${err}")
+  endif()
 else()
   message(FATAL_ERROR "cli_tools.cmake: unknown MODE '${MODE}'")
 endif()

@@ -663,21 +663,33 @@ protected:
                                  KernelFeatures::all(SAMPLER_UNIFORM).build_options());
   }
   void check_accumulate(int npix, int wave, uint64_t base);
+  void check_generate(int4 window, uint32_t first_pass);
   ClRuntime rt_;
   cl::Program program_;
 };
 
+// The whole film from pass 0, and a window of it from pass 17 (a crop of a sample range): the
+// film pixel and the pass of each path, and so its random numbers, are those of the full render.
 TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
+  for (int4 window : {make_int4(0, 0, 37, 23), make_int4(5, 3, 11, 7)}) {
+    const uint32_t first_pass = window.z == 37 ? 0 : 17;
+    check_generate(window, first_pass);
+  }
+}
+
+void KernelUtilities::check_generate(int4 window, uint32_t first_pass) {
   Camera cam;
   cam.position = make_float3(1, 2, 3);
   cam.look_at = make_float3(0, 0.5f, -1);
   cam.fov_y_deg = 40;
   const int w = 37, h = 23, n = 3000;
-  const uint64_t base = 123457; // a wave that starts mid-image, in the second pass
+  const uint64_t base = 123457; // a wave that starts mid-image, in a later pass
   std::vector<CameraParams> cp = {make_camera_params(cam, w, h)};
   KernelArgs args;
   args.set("cam", to_device(rt_, cp));
   args.set("seed", cl_uint(99));
+  args.set("window", window);
+  args.set("first_pass", cl_uint(first_pass));
   args.set("wave_base", cl_ulong(base));
   args.set("count", cl_int(n));
   for (const char* name : {"ray_o", "ray_d", "throughput", "radiance"})
@@ -695,9 +707,12 @@ TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
   float3 fwd = normalize(cam.look_at - cam.position), right = normalize(cross(fwd, cam.up));
   float3 up = cross(right, fwd);
   float th = std::tan(0.5f * 40.0f * float(M_PI) / 180.0f), tw = th * float(w) / float(h);
+  const uint64_t nwin = uint64_t(window.z) * uint64_t(window.w);
   for (int i = 0; i < n; ++i) {
     uint64_t g = base + uint64_t(i);
-    uint32_t pixel = uint32_t(g % uint64_t(w * h)), pass = uint32_t(g / uint64_t(w * h));
+    uint32_t in_win = uint32_t(g % nwin), pass = first_pass + uint32_t(g / nwin);
+    uint32_t pixel =
+        uint32_t((window.y + int(in_win) / window.z) * w + window.x + int(in_win) % window.z);
     PathRng r = rng_seed(99, pixel, pass);
     float jx = rng_next_float(&r), jy = rng_next_float(&r);
     float sx = (float(pixel % w) + jx) / float(w), sy = (float(pixel / w) + jy) / float(h);

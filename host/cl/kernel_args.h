@@ -38,6 +38,7 @@ public:
   ArgValue(cl_float v) { store("float", v); }
   ArgValue(const float4& v) { store("float4", v); }
   ArgValue(const int2& v) { store("int2", v); }
+  ArgValue(const int4& v) { store("int4", v); }
 
   bool empty() const { return type_ == nullptr; }
   // A flag, not type_ == kBuffer: the literal's address can differ between translation units

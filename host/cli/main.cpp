@@ -4,13 +4,16 @@
 //   canopy info
 //   canopy compare A.exr B.exr      (cli/compare_command.cpp)
 //   canopy converge SCENE ...       (cli/converge_command.cpp)
+//   canopy merge OUT.exr IN.exr...  (cli/merge_command.cpp)
 // Exit codes: 0 success, 2 invalid input (scene or arguments, unwritable outputs, work that does
 // not fit the device's or host's memory), 1 runtime failure (OpenCL errors and the like).
 #include "cl/runtime.h"
 #include "cli/compare_command.h"
 #include "cli/converge_command.h"
+#include "cli/merge_command.h"
 #include "image/error_stats.h"
 #include "image/image_io.h"
+#include "image/partial_image.h"
 #include "render/memory_budget.h"
 #include "render/renderer.h"
 #include "render/stats_report.h"
@@ -53,16 +56,32 @@ struct RenderArgs {
   std::optional<int> brdf_n_max;
   bool brdf_equal = false;
   std::optional<std::string> volume_importance;
+  std::optional<std::string> samples, crop; // "A:B", "x0,y0,x1,y1"
   std::string out, png, device, stats_json, heatmap, emitter_mask;
   bool stats = false;
+  bool quiet = false;
 };
 
-// A progress bar on stderr, shown only once a render has run for a second.
-class ProgressBar {
+// Render progress on stderr, once a render has run for a second: a bar redrawn in place on a
+// terminal; whole lines (every 10% and at the end, with the elapsed time) otherwise, so that a log
+// file (a Slurm task's, say) reads cleanly; nothing with --quiet.
+class Progress {
 public:
+  explicit Progress(bool quiet) : quiet_(quiet), terminal_(::isatty(STDERR_FILENO) == 1) {}
   void update(double fraction) {
+    if (quiet_) return;
     double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-    if (elapsed < 1.0 || (fraction < 1.0 && elapsed - last_ < 0.1)) return;
+    if (elapsed < 1.0) return;
+    if (!terminal_) {
+      int tenth = int(fraction * 10.0 + 1e-9);
+      if (tenth <= last_tenth_) return;
+      last_tenth_ = tenth;
+      shown_ = true;
+      std::fprintf(stderr, "canopy: %3d%% rendered, %.1f s\n", 10 * tenth, elapsed);
+      std::fflush(stderr);
+      return;
+    }
+    if (fraction < 1.0 && elapsed - last_ < 0.1) return;
     last_ = elapsed;
     shown_ = true;
     int filled = int(fraction * 40.0 + 0.5);
@@ -71,15 +90,55 @@ public:
     std::fflush(stderr);
   }
   void finish() {
-    if (shown_) std::fprintf(stderr, "\n");
+    if (shown_ && terminal_) std::fprintf(stderr, "\n");
   }
 
 private:
   using Clock = std::chrono::steady_clock;
+  bool quiet_, terminal_;
   Clock::time_point start_ = Clock::now();
   double last_ = -1.0;
+  int last_tenth_ = 0;
   bool shown_ = false;
 };
+
+// --samples A:B: the sample indices [A, B) of every pixel, 0 <= A < B <= kMaxSpp.
+std::pair<int, int> parse_sample_range(const std::string& text) {
+  size_t colon = text.find(':');
+  auto number = [](const std::string& s, long long& v) {
+    if (s.empty() || s.size() > 12 || s.find_first_not_of("0123456789") != std::string::npos)
+      return false;
+    v = std::stoll(s);
+    return true;
+  };
+  long long a = 0, b = 0;
+  if (colon == std::string::npos || !number(text.substr(0, colon), a) ||
+      !number(text.substr(colon + 1), b) || a >= b || b > kMaxSpp)
+    throw SceneError(fmt::format("--samples: '{}': want A:B with 0 <= A < B <= {}",
+                                 printable(text, 100), kMaxSpp));
+  return {int(a), int(b)};
+}
+
+// --crop x0,y0,x1,y1: the pixels [x0, x1) x [y0, y1), inside the film and not empty.
+PixelWindow parse_crop(const std::string& text, int width, int height) {
+  PixelWindow w;
+  int* v[4] = {&w.x0, &w.y0, &w.x1, &w.y1};
+  size_t pos = 0;
+  bool ok = true;
+  for (int i = 0; i < 4 && ok; ++i) {
+    size_t end = i < 3 ? text.find(',', pos) : text.size();
+    std::string part = end == std::string::npos ? "" : text.substr(pos, end - pos);
+    ok = !part.empty() && part.size() <= 6 &&
+         part.find_first_not_of("0123456789") == std::string::npos;
+    if (ok) *v[i] = std::stoi(part);
+    pos = end == std::string::npos ? end : end + 1;
+  }
+  if (!ok || w.x0 >= w.x1 || w.y0 >= w.y1 || w.x1 > width || w.y1 > height)
+    throw SceneError(fmt::format("--crop: '{}': want x0,y0,x1,y1 with 0 <= x0 < x1 <= {} and "
+                                 "0 <= y0 < y1 <= {} (the film)",
+                                 printable(text, 100), width, height));
+  return w;
+}
 
 std::string lower_ext(const fs::path& p) {
   std::string e = p.extension().string();
@@ -185,6 +244,16 @@ int run_render(const RenderArgs& args) {
       throw SceneError(fmt::format("--spp: must be in [1, {}], got {}", kMaxSpp, *args.spp));
     scene.integrator.spp = *args.spp;
   }
+  int first_sample = 0;
+  if (args.samples) {
+    if (args.spp)
+      throw SceneError("--samples and --spp: give one (--samples A:B renders B - A spp)");
+    auto [a, b] = parse_sample_range(*args.samples);
+    first_sample = a;
+    scene.integrator.spp = b - a;
+  }
+  PixelWindow window;
+  if (args.crop) window = parse_crop(*args.crop, scene.film.width, scene.film.height);
   if (args.seed) scene.integrator.seed = *args.seed;
   if (args.light_sampler) scene.integrator.light_sampler = *args.light_sampler;
   if (args.split_threshold) scene.integrator.split_threshold = *args.split_threshold;
@@ -272,13 +341,15 @@ int run_render(const RenderArgs& args) {
   ropt.brdf.lambda = scene.integrator.brdf_lambda;
   ropt.brdf.adaptive = scene.integrator.brdf_adaptive;
   Renderer renderer(rt, scene, ropt);
-  ProgressBar bar;
+  Progress progress(args.quiet);
   RenderSettings settings;
   settings.spp = scene.integrator.spp;
   settings.seed = scene.integrator.seed;
-  settings.progress = [&bar](double f) { bar.update(f); };
+  settings.first_sample = first_sample;
+  settings.window = window;
+  settings.progress = [&progress](double f) { progress.update(f); };
   Film film = renderer.render(settings);
-  bar.finish();
+  progress.finish();
 
   RgbImage img = film.mean();
   if (uint64_t n = renderer.stats().overflowed_pixels)
@@ -286,16 +357,29 @@ int run_render(const RenderArgs& args) {
                  "canopy: warning: %llu pixels exceed the float range of the image (3.4e38) and "
                  "are written as the largest finite float\n",
                  (unsigned long long)n);
-  write_exr(exr, img,
-            {{"canopy:scene", args.scene},
-             {"canopy:light_sampler", scene.integrator.light_sampler},
-             {"canopy:split_threshold", fmt::format("{}", scene.integrator.split_threshold)},
-             {"canopy:max_cut", std::to_string(scene.integrator.max_cut)},
-             {"canopy:max_depth", std::to_string(scene.integrator.max_depth)},
-             {"canopy:orientation_term", args.no_orientation ? "off" : "on"},
-             {"canopy:mis", scene.integrator.mis ? "on" : "off"},
-             {"canopy:spp", std::to_string(scene.integrator.spp)},
-             {"canopy:seed", std::to_string(scene.integrator.seed)}});
+  // Every image is a partial render (image/partial_image.h): `canopy merge` combines them.
+  PartialInfo part;
+  part.scene = args.scene;
+  part.scene_hash = scene_file_hash(args.scene);
+  part.version = canopy_version();
+  part.seed = scene.integrator.seed;
+  part.film_width = scene.film.width;
+  part.film_height = scene.film.height;
+  part.x0 = film.x0;
+  part.y0 = film.y0;
+  part.x1 = film.x0 + film.width;
+  part.y1 = film.y0 + film.height;
+  part.sample_begin = first_sample;
+  part.sample_end = first_sample + scene.integrator.spp;
+  write_partial_exr(
+      exr, img, part,
+      {{"canopy:light_sampler", scene.integrator.light_sampler},
+       {"canopy:split_threshold", fmt::format("{}", scene.integrator.split_threshold)},
+       {"canopy:max_cut", std::to_string(scene.integrator.max_cut)},
+       {"canopy:max_depth", std::to_string(scene.integrator.max_depth)},
+       {"canopy:orientation_term", args.no_orientation ? "off" : "on"},
+       {"canopy:mis", scene.integrator.mis ? "on" : "off"},
+       {"canopy:spp", std::to_string(scene.integrator.spp)}});
   write_png(png, img);
   if (!args.heatmap.empty()) write_png(args.heatmap, film.shadow_ray_heatmap());
   if (!args.emitter_mask.empty())
@@ -304,9 +388,14 @@ int run_render(const RenderArgs& args) {
   std::string skipped = scene.skipped_lights
                             ? fmt::format(" ({} with zero emission skipped)", scene.skipped_lights)
                             : std::string();
-  std::fprintf(stderr, "%s: %dx%d, %d spp, %s, max depth %d, %zu lights%s, %zu primitives on %s\n",
+  std::string part_text;
+  if (args.samples)
+    part_text += fmt::format(" (samples {}:{})", part.sample_begin, part.sample_end);
+  if (args.crop) part_text += fmt::format(", crop {},{},{},{}", part.x0, part.y0, part.x1, part.y1);
+  std::fprintf(stderr,
+               "%s: %dx%d, %d spp%s, %s, max depth %d, %zu lights%s, %zu primitives on %s\n",
                scene_name.c_str(), scene.film.width, scene.film.height, scene.integrator.spp,
-               sampler_summary(scene.integrator, !args.no_orientation).c_str(),
+               part_text.c_str(), sampler_summary(scene.integrator, !args.no_orientation).c_str(),
                scene.integrator.max_depth, scene.lights.size(), skipped.c_str(),
                renderer.geometry().prims.size(), rt.device_name().c_str());
   std::fprintf(stderr, "build %.3f s, compile %.3f s, render %.3f s%s\n", st.build_seconds,
@@ -376,6 +465,13 @@ int main(int argc, char** argv) {
   render->add_option("scene", rargs.scene, "Scene file (JSON, see docs/scene-format.md)")
       ->required();
   render->add_option("--spp", rargs.spp, "Samples per pixel (overrides the scene)");
+  render->add_option("--samples", rargs.samples,
+                     "A:B renders the sample indices [A, B) of every pixel (B - A spp): renders of "
+                     "disjoint ranges merge into the render of all of them (`canopy merge`)");
+  render->add_option("--crop", rargs.crop,
+                     "x0,y0,x1,y1 renders the film's pixels [x0, x1) x [y0, y1) only, the same as "
+                     "in the full render (a tile for `canopy merge`)");
+  render->add_flag("--quiet", rargs.quiet, "No progress report");
   render->add_option("--out", rargs.out,
                      "Output image: FILE.exr, or FILE.png; the other format is written beside it "
                      "with the other extension (default out/<scene>.exr). Written to a temporary "
@@ -434,6 +530,7 @@ int main(int argc, char** argv) {
   std::function<int()> action; // set by the subcommands defined in their own files
   add_compare_command(app, action);
   add_converge_command(app, action);
+  add_merge_command(app, action);
 
   // Every floating-point option of every subcommand refuses NaN and infinities.
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))

@@ -109,8 +109,16 @@ void write_pixels(const std::filesystem::path& file, const OIIO::ImageSpec& spec
 } // namespace
 
 void write_exr(const std::filesystem::path& file, const RgbImage& img,
-               const std::vector<std::pair<std::string, std::string>>& metadata) {
+               const std::vector<std::pair<std::string, std::string>>& metadata,
+               const std::optional<ImageWindow>& window) {
   OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
+  if (window) {
+    spec.x = window->x;
+    spec.y = window->y;
+    spec.full_x = spec.full_y = 0;
+    spec.full_width = window->full_width;
+    spec.full_height = window->full_height;
+  }
   spec.attribute("compression", "zip");
   for (const auto& [k, v] : metadata)
     spec.attribute(k, v);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,10 +14,18 @@ struct RgbImage {
   std::vector<float> rgb; // row-major, top row first, 3 floats per pixel, linear
 };
 
-// Writes a linear half/float EXR; `metadata` entries become string attributes (e.g.
-// "canopy:sampler"). Throws std::runtime_error naming the file on failure.
+// Where an image's pixels sit in a larger one: EXR's data window (origin x, y) inside its display
+// window (full_width x full_height from 0, 0).
+struct ImageWindow {
+  int x = 0, y = 0, full_width = 0, full_height = 0;
+};
+
+// Writes a linear float EXR; `metadata` entries become string attributes (e.g.
+// "canopy:sampler"); `window`, if given, places the pixels in a larger display window. Throws
+// std::runtime_error naming the file on failure.
 void write_exr(const std::filesystem::path& file, const RgbImage& img,
-               const std::vector<std::pair<std::string, std::string>>& metadata = {});
+               const std::vector<std::pair<std::string, std::string>>& metadata = {},
+               const std::optional<ImageWindow>& window = std::nullopt);
 
 // Writes an 8-bit PNG with the sRGB transfer curve (values clamped to [0, 1]).
 void write_png(const std::filesystem::path& file, const RgbImage& img);

@@ -170,7 +170,20 @@ Film Renderer::render(const RenderSettings& settings) {
   auto t_start = Clock::now();
   const cl::Context& ctx = rt_.context();
   cl::CommandQueue& q = rt_.queue();
-  const int width = scene_.film.width, height = scene_.film.height;
+  // The window of the film and the sample range rendered (generate.cl).
+  const int film_w = scene_.film.width, film_h = scene_.film.height;
+  const PixelWindow win =
+      settings.window.empty() ? PixelWindow{0, 0, film_w, film_h} : settings.window;
+  if (win.x0 < 0 || win.y0 < 0 || win.x1 > film_w || win.y1 > film_h)
+    throw std::invalid_argument(fmt::format("render window [{}, {}) x [{}, {}) is outside the "
+                                            "{}x{} film",
+                                            win.x0, win.x1, win.y0, win.y1, film_w, film_h));
+  if (settings.spp < 1 || settings.first_sample < 0 ||
+      int64_t(settings.first_sample) + settings.spp > kMaxSpp)
+    throw std::invalid_argument(
+        fmt::format("render samples [{}, {}) are outside [0, {}]", settings.first_sample,
+                    int64_t(settings.first_sample) + settings.spp, kMaxSpp));
+  const int width = win.width(), height = win.height();
   const int npix = width * height;
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
   // A cut never holds more items in a pass than its budget, nor more than max_cut (every light, for
@@ -212,6 +225,8 @@ Film Renderer::render(const RenderSettings& settings) {
   device_.set_args(args);
   args.set("cam", camera_);
   args.set("seed", cl_uint(settings.seed));
+  args.set("window", make_int4(win.x0, win.y0, width, height));
+  args.set("first_pass", cl_uint(settings.first_sample));
   args.set("max_depth", cl_int(max_depth));
   args.set("npix", cl_int(npix));
   args.set("block", cl_int(kScanBlock));
@@ -416,6 +431,10 @@ Film Renderer::render(const RenderSettings& settings) {
   Film film;
   film.width = width;
   film.height = height;
+  film.x0 = win.x0;
+  film.y0 = win.y0;
+  film.film_width = film_w;
+  film.film_height = film_h;
   film.sum.resize(size_t(npix));
   film.sumsq.resize(size_t(npix));
   film.counts.resize(size_t(npix));

@@ -66,10 +66,21 @@ static_assert(sizeof(double4) == 32 && sizeof(double2) == 16);
 static_assert(sizeof(Material) == 64 && sizeof(Light) == 96 && sizeof(Primitive) == 64 &&
               sizeof(Medium) == 64);
 
+// A window [x0, x1) x [y0, y1) of the film's pixels; empty: the whole film.
+struct PixelWindow {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+  int width() const { return x1 - x0; }
+  int height() const { return y1 - y0; }
+};
+
 // Per-pixel running sums in double, in the scene's emission units (the device's emission scale
-// already undone): sum.xyz = radiance sum, sum.w = sample count, sumsq = second moment.
+// already undone): sum.xyz = radiance sum, sum.w = sample count, sumsq = second moment. The
+// pixels of the rendered window (the whole film unless cropped: RenderSettings::window).
 struct Film {
-  int width = 0, height = 0;
+  int width = 0, height = 0; // the window's
+  int x0 = 0, y0 = 0;        // the window's first pixel in the film
+  int film_width = 0, film_height = 0;
   std::vector<double4> sum, sumsq;
   // Per pixel, summed over samples: (shadow rays, shading points, samples whose camera ray hit an
   // emitter, 0).
@@ -89,6 +100,12 @@ struct Film {
 struct RenderSettings {
   int spp = 1;
   uint32_t seed = 1;
+  // The samples rendered are the indices [first_sample, first_sample + spp) of each pixel of the
+  // window (the whole film when empty). A sample's random numbers depend only on (seed, pixel,
+  // sample index), so renders of disjoint ranges and windows merge into the full image
+  // (`canopy merge`). first_sample + spp <= kMaxSpp.
+  int first_sample = 0;
+  PixelWindow window;
   size_t wave_size = size_t(1) << 18; // paths per wave (smaller when splitting: see render())
   std::function<void(double fraction)> progress; // optional, called after each wave
 };
