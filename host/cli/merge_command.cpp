@@ -23,7 +23,6 @@ struct MergeArgs {
 int run_merge(const MergeArgs& a) {
   if (std::filesystem::path(a.out).extension() != ".exr")
     throw SceneError(fmt::format("merge: {}: the output must end in .exr", printable(a.out, 1024)));
-  std::vector<PartialImage> parts;
   std::vector<std::string> names;
   for (const std::string& in : a.inputs) {
     if (std::filesystem::path(in) == std::filesystem::path(a.out))
@@ -31,11 +30,13 @@ int run_merge(const MergeArgs& a) {
           fmt::format("merge: {}: is both an input and the output", printable(in, 1024)));
     names.push_back(printable(in, 1024));
   }
+  // One input in memory at a time (a farm's pieces may each hold the whole film).
   MergeResult r;
   try {
-    for (const std::string& in : a.inputs)
-      parts.push_back(read_partial_exr(in));
-    r = merge_partials(parts, names);
+    PartialMerger merger;
+    for (size_t i = 0; i < a.inputs.size(); ++i)
+      merger.add(read_partial_exr(a.inputs[i]), names[i]);
+    r = merger.finish();
   } catch (const MergeError& e) {
     throw SceneError(e.what());
   }
@@ -43,7 +44,7 @@ int run_merge(const MergeArgs& a) {
     std::fprintf(stderr,
                  "canopy: warning: merge: the inputs come from different Canopy versions\n");
   std::vector<std::pair<std::string, std::string>> extra = {
-      {"canopy:merged_inputs", std::to_string(parts.size())},
+      {"canopy:merged_inputs", std::to_string(a.inputs.size())},
       {"canopy:spp", r.min_samples == r.max_samples
                          ? std::to_string(r.max_samples)
                          : fmt::format("{}..{}", r.min_samples, r.max_samples)}};
@@ -57,7 +58,7 @@ int run_merge(const MergeArgs& a) {
     meta.insert(meta.end(), extra.begin(), extra.end());
     write_exr(a.out, r.image, meta);
   }
-  std::printf("merged %zu images into %s: %dx%d, %u samples per pixel%s\n", parts.size(),
+  std::printf("merged %zu images into %s: %dx%d, %u samples per pixel%s\n", a.inputs.size(),
               printable(a.out, 1024).c_str(), r.image.width, r.image.height, r.max_samples,
               r.uniform ? fmt::format(" (samples {}:{} of seed {})", r.info.sample_begin,
                                       r.info.sample_end, r.info.seed)

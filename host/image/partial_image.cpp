@@ -156,86 +156,99 @@ PartialImage read_partial_exr(const std::filesystem::path& file) {
   return p;
 }
 
-MergeResult merge_partials(const std::vector<PartialImage>& parts,
-                           const std::vector<std::string>& names) {
-  if (parts.empty()) throw MergeError("merge: no input images");
-  const PartialInfo& ref = parts[0].info;
-  for (size_t i = 1; i < parts.size(); ++i) {
-    const PartialInfo& a = parts[i].info;
+void PartialMerger::add(const PartialImage& part, const std::string& name) {
+  const PartialInfo& a = part.info;
+  if (!infos_.empty()) {
+    const PartialInfo& ref = infos_[0];
     if (a.scene_hash != ref.scene_hash)
       throw MergeError(fmt::format("{}: rendered from scene {} (hash {}), {} from {} (hash {})",
-                                   names[i], printable(a.scene, 300), a.scene_hash, names[0],
+                                   name, printable(a.scene, 300), a.scene_hash, names_[0],
                                    printable(ref.scene, 300), ref.scene_hash));
     if (a.film_width != ref.film_width || a.film_height != ref.film_height)
-      throw MergeError(fmt::format("{}: film {}x{}, {} has {}x{}", names[i], a.film_width,
-                                   a.film_height, names[0], ref.film_width, ref.film_height));
+      throw MergeError(fmt::format("{}: film {}x{}, {} has {}x{}", name, a.film_width,
+                                   a.film_height, names_[0], ref.film_width, ref.film_height));
   }
   // The same samples (seed and index) of the same pixel twice would count them twice.
-  for (size_t i = 0; i < parts.size(); ++i)
-    for (size_t j = i + 1; j < parts.size(); ++j) {
-      const PartialInfo &a = parts[i].info, &b = parts[j].info;
-      int s0 = std::max(a.sample_begin, b.sample_begin), s1 = std::min(a.sample_end, b.sample_end);
-      int x0 = std::max(a.x0, b.x0), x1 = std::min(a.x1, b.x1);
-      int y0 = std::max(a.y0, b.y0), y1 = std::min(a.y1, b.y1);
-      if (a.seed == b.seed && s0 < s1 && x0 < x1 && y0 < y1)
-        throw MergeError(
-            fmt::format("{} and {} both hold samples [{}, {}) of seed {} for pixels {}", names[i],
-                        names[j], s0, s1, a.seed, window_text(x0, y0, x1, y1)));
+  for (size_t i = 0; i < infos_.size(); ++i) {
+    const PartialInfo& b = infos_[i];
+    int s0 = std::max(a.sample_begin, b.sample_begin), s1 = std::min(a.sample_end, b.sample_end);
+    int x0 = std::max(a.x0, b.x0), x1 = std::min(a.x1, b.x1);
+    int y0 = std::max(a.y0, b.y0), y1 = std::min(a.y1, b.y1);
+    if (a.seed == b.seed && s0 < s1 && x0 < x1 && y0 < y1)
+      throw MergeError(fmt::format("{} and {} both hold samples [{}, {}) of seed {} for pixels {}",
+                                   names_[i], name, s0, s1, a.seed, window_text(x0, y0, x1, y1)));
+  }
+  const size_t W = size_t(a.film_width);
+  if (infos_.empty()) {
+    const size_t npix = W * size_t(a.film_height);
+    sum_.assign(3 * npix, 0.0);
+    count_.assign(npix, 0);
+    lo_.assign(npix, std::numeric_limits<int>::max());
+    hi_.assign(npix, 0);
+  }
+  mixed_versions_ = mixed_versions_ || (!infos_.empty() && a.version != infos_[0].version);
+  infos_.push_back(a);
+  names_.push_back(name);
+  const double n = double(a.samples());
+  for (int y = a.y0; y < a.y1; ++y)
+    for (int x = a.x0; x < a.x1; ++x) {
+      size_t f = size_t(y) * W + size_t(x);
+      size_t w = size_t(y - a.y0) * size_t(a.x1 - a.x0) + size_t(x - a.x0);
+      for (size_t c = 0; c < 3; ++c)
+        sum_[3 * f + c] += n * double(part.pixels.rgb[3 * w + c]);
+      count_[f] += uint64_t(a.samples());
+      lo_[f] = std::min(lo_[f], a.sample_begin);
+      hi_[f] = std::max(hi_[f], a.sample_end);
     }
+}
 
+MergeResult PartialMerger::finish() const {
+  if (infos_.empty()) throw MergeError("merge: no input images");
   MergeResult r;
+  const PartialInfo& ref = infos_[0];
   const int W = ref.film_width, H = ref.film_height;
   const size_t npix = size_t(W) * size_t(H);
-  std::vector<double> sum(3 * npix, 0.0);
-  std::vector<uint64_t> count(npix, 0);
-  // Per pixel, the smallest first and largest end index merged into it (for `uniform`).
-  std::vector<int> lo(npix, std::numeric_limits<int>::max()), hi(npix, 0);
   bool one_seed = true;
-  for (const PartialImage& p : parts) {
-    const PartialInfo& a = p.info;
+  for (const PartialInfo& a : infos_)
     one_seed = one_seed && a.seed == ref.seed;
-    r.mixed_versions = r.mixed_versions || a.version != ref.version;
-    const double n = double(a.samples());
-    for (int y = a.y0; y < a.y1; ++y)
-      for (int x = a.x0; x < a.x1; ++x) {
-        size_t f = size_t(y) * size_t(W) + size_t(x);
-        size_t w = size_t(y - a.y0) * size_t(a.x1 - a.x0) + size_t(x - a.x0);
-        for (size_t c = 0; c < 3; ++c)
-          sum[3 * f + c] += n * double(p.pixels.rgb[3 * w + c]);
-        count[f] += uint64_t(a.samples());
-        lo[f] = std::min(lo[f], a.sample_begin);
-        hi[f] = std::max(hi[f], a.sample_end);
-      }
-  }
+  r.mixed_versions = mixed_versions_;
   r.image.width = W;
   r.image.height = H;
   r.image.rgb.assign(3 * npix, 0.0f);
   r.samples.resize(npix);
   uint64_t cmin = std::numeric_limits<uint64_t>::max(), cmax = 0;
   for (size_t f = 0; f < npix; ++f) {
-    cmin = std::min(cmin, count[f]);
-    cmax = std::max(cmax, count[f]);
-    if (count[f] > 0)
+    cmin = std::min(cmin, count_[f]);
+    cmax = std::max(cmax, count_[f]);
+    if (count_[f] > 0)
       for (size_t c = 0; c < 3; ++c)
-        r.image.rgb[3 * f + c] = float(sum[3 * f + c] / double(count[f]));
+        r.image.rgb[3 * f + c] = float(sum_[3 * f + c] / double(count_[f]));
   }
   for (size_t f = 0; f < npix; ++f) {
-    r.samples[f] = uint32_t(std::min<uint64_t>(count[f], 0xffffffffu));
-    if (count[f] < cmax) ++r.short_pixels;
+    r.samples[f] = uint32_t(std::min<uint64_t>(count_[f], 0xffffffffu));
+    if (count_[f] < cmax) ++r.short_pixels;
   }
   r.min_samples = uint32_t(std::min<uint64_t>(cmin, 0xffffffffu));
   r.max_samples = uint32_t(std::min<uint64_t>(cmax, 0xffffffffu));
   // One contiguous range of one seed in every pixel: itself a partial image of the whole film.
   r.uniform = one_seed && cmin == cmax && cmin > 0;
   for (size_t f = 0; r.uniform && f < npix; ++f)
-    r.uniform = lo[f] == lo[0] && uint64_t(hi[f] - lo[f]) == count[f];
+    r.uniform = lo_[f] == lo_[0] && uint64_t(hi_[f] - lo_[f]) == count_[f];
   r.info = ref;
   r.info.x0 = r.info.y0 = 0;
   r.info.x1 = W;
   r.info.y1 = H;
-  r.info.sample_begin = r.uniform ? lo[0] : 0;
-  r.info.sample_end = r.uniform ? hi[0] : 0;
+  r.info.sample_begin = r.uniform ? lo_[0] : 0;
+  r.info.sample_end = r.uniform ? hi_[0] : 0;
   return r;
+}
+
+MergeResult merge_partials(const std::vector<PartialImage>& parts,
+                           const std::vector<std::string>& names) {
+  PartialMerger m;
+  for (size_t i = 0; i < parts.size(); ++i)
+    m.add(parts[i], names[i]);
+  return m.finish();
 }
 
 } // namespace canopy

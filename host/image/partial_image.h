@@ -71,9 +71,25 @@ struct MergeResult {
   bool mixed_versions = false; // inputs of different Canopy versions (merged, with a warning)
 };
 
-// Merges partial images by sample count. `names` label the inputs in errors. Throws MergeError for
-// images of different scenes (by hash) or film sizes, or that hold the same samples (same seed,
-// overlapping ranges) of the same pixels.
+// Merges partial images by sample count, one at a time, so that only one image and the film's
+// sums are in memory at once. add() throws MergeError (one line; `name` labels the image) for an
+// image of another scene (by hash) or film size than the first, or that holds samples (same seed,
+// overlapping ranges) of pixels an earlier image holds.
+class PartialMerger {
+public:
+  void add(const PartialImage& part, const std::string& name);
+  MergeResult finish() const; // throws MergeError if nothing was added
+
+private:
+  std::vector<PartialInfo> infos_;
+  std::vector<std::string> names_;
+  std::vector<double> sum_;     // per film pixel and channel: samples x mean
+  std::vector<uint64_t> count_; // per film pixel: samples
+  std::vector<int> lo_, hi_;    // per film pixel: the smallest first and largest end index
+  bool mixed_versions_ = false;
+};
+
+// PartialMerger over `parts`, labelled by `names`.
 MergeResult merge_partials(const std::vector<PartialImage>& parts,
                            const std::vector<std::string>& names);
 
