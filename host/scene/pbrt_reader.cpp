@@ -124,19 +124,53 @@ bool is_bool_ident(const Token& t) {
 
 // The format page, "Basic structure": '#' starts a comment to the end of the line; strings are
 // double-quoted on one line; numbers, brackets and bare identifiers (directives, true/false)
-// are separated by white space.
-std::vector<Token> tokenize(const std::string& text, const std::string* file) {
-  std::vector<Token> out;
-  size_t i = 0, n = text.size();
-  int line = 1;
+// are separated by white space. Tokens are made one at a time as the reader asks for them, so a
+// mesh of N numbers costs N doubles, not N tokens.
+class Lexer {
+public:
+  Lexer(const std::string& text, const std::string* file) : text_(text), file_(file) {}
+  // The next token, or nullptr at the end of the text.
+  const Token* peek() {
+    if (!has_) has_ = lex(tok_);
+    return has_ ? &tok_ : nullptr;
+  }
+  // Consumes and returns the next token; the caller has checked peek().
+  Token next() {
+    peek();
+    has_ = false;
+    return std::move(tok_);
+  }
+  // True at the end of the text or at the next directive (an identifier other than true/false).
+  bool at_directive() {
+    const Token* t = peek();
+    return !t || (t->kind == Tok::Ident && !is_bool_ident(*t));
+  }
+  Loc here() const { return {file_, line_}; }
+
+private:
+  bool lex(Token& out);
+
+  const std::string& text_;
+  const std::string* file_;
+  size_t i_ = 0;
+  int line_ = 1;
+  Token tok_{Tok::Ident, {}, 0.0, {}};
+  bool has_ = false;
+};
+
+bool Lexer::lex(Token& out) {
+  const std::string& text = text_;
+  size_t& i = i_;
+  const size_t n = text.size();
   auto delim = [](char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '[' || c == ']' || c == '"' ||
            c == '#';
   };
   while (i < n) {
     char c = text[i];
+    const Loc loc{file_, line_};
     if (c == '\n') {
-      ++line;
+      ++line_;
       ++i;
     } else if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
       ++i;
@@ -144,11 +178,11 @@ std::vector<Token> tokenize(const std::string& text, const std::string* file) {
       while (i < n && text[i] != '\n')
         ++i;
     } else if (c == '[' || c == ']') {
-      out.push_back(
-          {c == '[' ? Tok::LBracket : Tok::RBracket, std::string(1, c), 0.0, {file, line}});
+      out = {c == '[' ? Tok::LBracket : Tok::RBracket, std::string(1, c), 0.0, loc};
       ++i;
+      return true;
     } else if (c == '"') {
-      Token t{Tok::String, {}, 0.0, {file, line}};
+      out = {Tok::String, {}, 0.0, loc};
       ++i;
       bool closed = false;
       while (i < n) {
@@ -162,36 +196,37 @@ std::vector<Token> tokenize(const std::string& text, const std::string* file) {
           char e = text[i++];
           d = e == 'n' ? '\n' : e == 't' ? '\t' : e == 'r' ? '\r' : e == 'b' ? '\b' : e;
         }
-        t.text.push_back(d);
+        out.text.push_back(d);
       }
-      if (!closed) fail(t.loc, "unterminated string");
-      out.push_back(std::move(t));
+      if (!closed) fail(loc, "unterminated string");
+      return true;
     } else if ((c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.') {
       size_t j = i;
       while (j < n && !delim(text[j]))
         ++j;
-      Token t{Tok::Number, text.substr(i, j - i), 0.0, {file, line}};
-      std::string_view s(t.text);
-      if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+      out = {Tok::Number, text.substr(i, j - i), 0.0, loc};
+      std::string_view sv(out.text);
+      if (!sv.empty() && sv[0] == '+') sv.remove_prefix(1);
       double v = 0.0;
-      auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-      if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size())
-        fail(t.loc, fmt::format("bad number '{}'", printable(t.text)));
-      if (!std::isfinite(v)) fail(t.loc, fmt::format("number '{}' is not finite", t.text));
-      t.num = v;
-      out.push_back(std::move(t));
+      auto r = std::from_chars(sv.data(), sv.data() + sv.size(), v);
+      if (sv.empty() || r.ec != std::errc() || r.ptr != sv.data() + sv.size())
+        fail(loc, fmt::format("bad number '{}'", printable(out.text)));
+      if (!std::isfinite(v)) fail(loc, fmt::format("number '{}' is not finite", out.text));
+      out.num = v;
       i = j;
+      return true;
     } else if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_') {
       size_t j = i;
       while (j < n && (std::isalnum(static_cast<unsigned char>(text[j])) || text[j] == '_'))
         ++j;
-      out.push_back({Tok::Ident, text.substr(i, j - i), 0.0, {file, line}});
+      out = {Tok::Ident, text.substr(i, j - i), 0.0, loc};
       i = j;
+      return true;
     } else {
-      fail({file, line}, fmt::format("unexpected character '{}'", printable(text.substr(i, 1))));
+      fail(loc, fmt::format("unexpected character '{}'", printable(text.substr(i, 1))));
     }
   }
-  return out;
+  return false;
 }
 
 std::string describe(const Token& t) {
@@ -227,11 +262,12 @@ bool is_numeric_type(const std::string& t) {
   return k.count(t) > 0;
 }
 
-// Reads the parameter list that starts at a[i]; checks each value against its declared type.
-std::vector<Param> parse_params(const std::vector<Token>& a, size_t i) {
+// Reads the parameter list up to the next directive; checks each value against its declared
+// type.
+std::vector<Param> parse_params(Lexer& lx) {
   std::vector<Param> ps;
-  while (i < a.size()) {
-    const Token& d = a[i];
+  while (!lx.at_directive()) {
+    const Token d = lx.next();
     if (d.kind != Tok::String)
       fail(d.loc, fmt::format("expected a parameter \"type name\", got {}", describe(d)));
     Param p;
@@ -256,48 +292,46 @@ std::vector<Param> parse_params(const std::vector<Token>& a, size_t i) {
     for (const Param& q : ps)
       if (q.name == p.name)
         fail(d.loc, fmt::format("parameter '{}' given twice", printable(p.name)));
-    ++i;
-    if (i >= a.size()) fail(d.loc, fmt::format("parameter '{}' has no value", printable(p.name)));
-    std::vector<const Token*> vals;
-    if (a[i].kind == Tok::LBracket) {
-      ++i;
-      while (i < a.size() && a[i].kind != Tok::RBracket) {
-        if (a[i].kind == Tok::LBracket) fail(a[i].loc, "'[' inside a value list");
-        vals.push_back(&a[i]);
-        ++i;
-      }
-      if (i >= a.size()) fail(d.loc, fmt::format("parameter '{}': '[' without ']'", p.name));
-      ++i;
-    } else if (a[i].kind == Tok::RBracket) {
-      fail(a[i].loc, "']' without '['");
-    } else {
-      vals.push_back(&a[i]);
-      ++i;
-    }
     const std::string pn = fmt::format("\"{} {}\"", p.type, printable(p.name));
-    if (vals.empty()) fail(d.loc, fmt::format("{}: no values", pn));
-    bool numeric =
-        is_numeric_type(p.type) || (p.type == "spectrum" && vals[0]->kind == Tok::Number);
-    for (const Token* v : vals) {
+    // The kind of the values (numbers or strings) is set by the type, and for "spectrum" by the
+    // first value (wavelength-value pairs or a named spectrum).
+    int numeric = is_numeric_type(p.type) ? 1 : p.type == "spectrum" ? -1 : 0;
+    auto take = [&](const Token& v) {
+      if (numeric < 0) numeric = v.kind == Tok::Number ? 1 : 0;
       if (numeric) {
-        if (v->kind != Tok::Number)
-          fail(v->loc, fmt::format("{}: expected a number, got {}", pn, describe(*v)));
-        if (p.type == "integer" &&
-            (v->num != std::floor(v->num) || std::fabs(v->num) > 2147483647.0))
-          fail(v->loc, fmt::format("{}: '{}' is not an integer", pn, v->text));
-        p.nums.push_back(v->num);
+        if (v.kind != Tok::Number)
+          fail(v.loc, fmt::format("{}: expected a number, got {}", pn, describe(v)));
+        if (p.type == "integer" && (v.num != std::floor(v.num) || std::fabs(v.num) > 2147483647.0))
+          fail(v.loc, fmt::format("{}: '{}' is not an integer", pn, v.text));
+        p.nums.push_back(v.num);
       } else if (p.type == "bool") {
-        if (!(v->kind == Tok::String || is_bool_ident(*v)) ||
-            (v->text != "true" && v->text != "false"))
-          fail(v->loc, fmt::format("{}: expected true or false, got {}", pn, describe(*v)));
-        p.strs.push_back(v->text);
+        if (!(v.kind == Tok::String || is_bool_ident(v)) || (v.text != "true" && v.text != "false"))
+          fail(v.loc, fmt::format("{}: expected true or false, got {}", pn, describe(v)));
+        p.strs.push_back(v.text);
       } else {
-        if (v->kind != Tok::String)
-          fail(v->loc, fmt::format("{}: expected a quoted string, got {}", pn, describe(*v)));
-        p.strs.push_back(v->text);
+        if (v.kind != Tok::String)
+          fail(v.loc, fmt::format("{}: expected a quoted string, got {}", pn, describe(v)));
+        p.strs.push_back(v.text);
       }
+    };
+    if (lx.at_directive())
+      fail(d.loc, fmt::format("parameter '{}' has no value", printable(p.name)));
+    if (lx.peek()->kind == Tok::LBracket) {
+      lx.next();
+      while (true) {
+        if (lx.at_directive()) fail(d.loc, fmt::format("{}: '[' without ']'", pn));
+        Token v = lx.next();
+        if (v.kind == Tok::RBracket) break;
+        if (v.kind == Tok::LBracket) fail(v.loc, "'[' inside a value list");
+        take(v);
+      }
+    } else if (lx.peek()->kind == Tok::RBracket) {
+      fail(lx.peek()->loc, "']' without '['");
+    } else {
+      take(lx.next());
     }
     size_t cnt = numeric ? p.nums.size() : p.strs.size();
+    if (cnt == 0) fail(d.loc, fmt::format("{}: no values", pn));
     auto want = [&](bool ok, std::string_view what) {
       if (!ok) fail(d.loc, fmt::format("{}: wrong count of values ({}; {})", pn, cnt, what));
     };
@@ -435,13 +469,11 @@ public:
   void finish();
 
 private:
-  void run_tokens(const std::vector<Token>& t, const std::filesystem::path& dir);
-  void directive(const Token& d, const std::vector<Token>& a, const std::filesystem::path& dir);
+  void directive(const Token& d, Lexer& lx, const std::filesystem::path& dir);
 
   // Directive parts.
-  std::vector<double> numbers(const Token& d, const std::vector<Token>& a, size_t want,
-                              bool brackets_ok);
-  std::string one_string(const Token& d, const std::vector<Token>& a, size_t& i);
+  std::vector<double> numbers(const Token& d, Lexer& lx, size_t want, bool brackets_ok);
+  std::string one_string(const Token& d, Lexer& lx);
   void camera(const Token& d, Params& p, const std::string& type);
   void finish_camera(const Loc& loc);
   void shape(const Token& d, Params& p, const std::string& type);
@@ -721,60 +753,60 @@ void Reader::run_file(const std::filesystem::path& file, const std::string& disp
 void Reader::run_text(const std::string& text, const std::string& display,
                       const std::filesystem::path& dir) {
   names_.push_back(display);
-  std::vector<Token> toks = tokenize(text, &names_.back());
-  run_tokens(toks, dir);
-}
-
-void Reader::run_tokens(const std::vector<Token>& t, const std::filesystem::path& dir) {
-  size_t i = 0;
-  std::vector<Token> args;
-  while (i < t.size()) {
-    const Token& d = t[i];
+  Lexer lx(text, &names_.back());
+  while (lx.peek()) {
+    const Token d = lx.next();
     if (d.kind != Tok::Ident || is_bool_ident(d))
       fail(d.loc, fmt::format("expected a directive, got {}", describe(d)));
-    size_t j = i + 1;
-    while (j < t.size() && (t[j].kind != Tok::Ident || is_bool_ident(t[j])))
-      ++j;
-    args.assign(t.begin() + std::ptrdiff_t(i + 1), t.begin() + std::ptrdiff_t(j));
     last_loc_ = d.loc;
-    directive(d, args, dir);
-    i = j;
+    directive(d, lx, dir);
   }
 }
 
-std::vector<double> Reader::numbers(const Token& d, const std::vector<Token>& a, size_t want,
-                                    bool brackets_ok) {
+std::vector<double> Reader::numbers(const Token& d, Lexer& lx, size_t want, bool brackets_ok) {
   std::vector<double> v;
-  size_t i = 0, n = a.size();
-  bool br = brackets_ok && n >= 2 && a[0].kind == Tok::LBracket && a[n - 1].kind == Tok::RBracket;
-  if (br) {
-    i = 1;
-    --n;
-  }
-  for (; i < n; ++i) {
-    if (a[i].kind != Tok::Number)
-      fail(a[i].loc, fmt::format("{}: expected a number, got {}", d.text, describe(a[i])));
-    v.push_back(a[i].num);
+  const bool br = brackets_ok && lx.peek() && lx.peek()->kind == Tok::LBracket;
+  if (br) lx.next();
+  while (v.size() <= want) { // one more than wanted is enough to report the count
+    if (br && lx.peek() && lx.peek()->kind == Tok::RBracket) {
+      lx.next();
+      break;
+    }
+    if (lx.at_directive()) {
+      if (br) fail(d.loc, fmt::format("{}: '[' without ']'", d.text));
+      break;
+    }
+    Token t = lx.next();
+    if (t.kind != Tok::Number)
+      fail(t.loc, fmt::format("{}: expected a number, got {}", d.text, describe(t)));
+    v.push_back(t.num);
   }
   if (v.size() != want)
-    fail(d.loc,
-         fmt::format("{}: wrong count of values ({}; want {} numbers)", d.text, v.size(), want));
+    fail(d.loc, fmt::format("{}: wrong count of values ({}{}; want {} numbers)", d.text,
+                            v.size() > want ? "more than " : "", std::min(v.size(), want), want));
+  if (!lx.at_directive())
+    fail(lx.peek()->loc, fmt::format("{}: unexpected {}", d.text, describe(*lx.peek())));
   return v;
 }
 
-std::string Reader::one_string(const Token& d, const std::vector<Token>& a, size_t& i) {
-  if (i >= a.size() || a[i].kind != Tok::String)
-    fail(i < a.size() ? a[i].loc : d.loc,
+std::string Reader::one_string(const Token& d, Lexer& lx) {
+  const Token* t = lx.peek();
+  if (!t || t->kind != Tok::String)
+    fail(t && !lx.at_directive() ? t->loc : d.loc,
          fmt::format("{}: expected a quoted name{}", d.text,
-                     i < a.size() ? ", got " + describe(a[i]) : ""));
-  return a[i++].text;
+                     t && !lx.at_directive() ? ", got " + describe(*t) : ""));
+  return lx.next().text;
 }
 
-void Reader::directive(const Token& d, const std::vector<Token>& a,
-                       const std::filesystem::path& dir) {
+void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& dir) {
   const std::string& k = d.text;
   auto no_args = [&] {
-    if (!a.empty()) fail(a[0].loc, fmt::format("{}: unexpected {}", k, describe(a[0])));
+    if (!lx.at_directive())
+      fail(lx.peek()->loc, fmt::format("{}: unexpected {}", k, describe(*lx.peek())));
+  };
+  auto skip = [&] { // the arguments of a directive that is not read
+    while (!lx.at_directive())
+      lx.next();
   };
   auto need_world = [&](bool inside) {
     if (world_block_ != inside)
@@ -786,9 +818,8 @@ void Reader::directive(const Token& d, const std::vector<Token>& a,
   if (k == "Include" || k == "Import") {
     // Import may only add named things in pbrt-v4 (it exists so files can be parsed in
     // parallel); read sequentially, it is the same as Include.
-    size_t i = 0;
-    std::string f = one_string(d, a, i);
-    if (i != a.size()) fail(a[i].loc, fmt::format("{}: unexpected {}", k, describe(a[i])));
+    std::string f = one_string(d, lx);
+    no_args();
     std::filesystem::path p(f);
     if (p.is_relative()) p = dir / p;
     run_file(p, p.lexically_normal().string(), &d.loc);
@@ -820,14 +851,14 @@ void Reader::directive(const Token& d, const std::vector<Token>& a,
     gs_.reverse = !gs_.reverse;
   } else if (k == "Option") {
     warn(d.loc, "Option: rendering options are not read, ignored");
+    skip();
   } else if (k == "ObjectBegin") {
     // Object instances are flattened: each ObjectInstance copies the object's triangles with the
     // instance transform into the one triangle soup (Canopy's BVH has no instance level). Memory
     // grows with instances x triangles, capped by kMaxTriangles.
     need_world(true);
-    size_t i = 0;
-    std::string name = one_string(d, a, i);
-    if (i != a.size()) fail(a[i].loc, fmt::format("{}: unexpected {}", k, describe(a[i])));
+    std::string name = one_string(d, lx);
+    no_args();
     if (object_) fail(d.loc, "ObjectBegin inside another ObjectBegin");
     if (objects_.count(name))
       fail(d.loc, fmt::format("object \"{}\" is defined twice", printable(name)));
@@ -845,9 +876,8 @@ void Reader::directive(const Token& d, const std::vector<Token>& a,
     object_ = nullptr;
   } else if (k == "ObjectInstance") {
     need_world(true);
-    size_t i = 0;
-    std::string name = one_string(d, a, i);
-    if (i != a.size()) fail(a[i].loc, fmt::format("{}: unexpected {}", k, describe(a[i])));
+    std::string name = one_string(d, lx);
+    no_args();
     if (object_) fail(d.loc, "ObjectInstance inside ObjectBegin");
     auto it = objects_.find(name);
     if (it == objects_.end()) fail(d.loc, fmt::format("unknown object \"{}\"", printable(name)));
@@ -859,19 +889,19 @@ void Reader::directive(const Token& d, const std::vector<Token>& a,
     no_args();
     gs_.ctm = Transform{};
   } else if (k == "Translate") {
-    auto v = numbers(d, a, 3, false);
+    auto v = numbers(d, lx, 3, false);
     post(Transform::translate({v[0], v[1], v[2]}));
   } else if (k == "Scale") {
-    auto v = numbers(d, a, 3, false);
+    auto v = numbers(d, lx, 3, false);
     post(Transform::scale({v[0], v[1], v[2]}));
   } else if (k == "Rotate") {
-    auto v = numbers(d, a, 4, false);
+    auto v = numbers(d, lx, 4, false);
     double3 ax{v[1], v[2], v[3]};
     double l = len3(ax);
     if (!(l > 0.0) || !std::isfinite(l)) fail(d.loc, "Rotate: the axis must be non-zero");
     post(Transform::rotate(ax * (1.0 / l), v[0]));
   } else if (k == "LookAt") {
-    auto v = numbers(d, a, 9, false);
+    auto v = numbers(d, lx, 9, false);
     double3 eye{v[0], v[1], v[2]}, at{v[3], v[4], v[5]}, up{v[6], v[7], v[8]};
     double3 dirv = at - eye;
     double dl = len3(dirv), ul = len3(up);
@@ -895,20 +925,18 @@ void Reader::directive(const Token& d, const std::vector<Token>& a,
     cam_from_world.t = {-dot3(right, eye), -dot3(nup, eye), -dot3(dirv, eye)};
     post(cam_from_world);
   } else if (k == "Transform" || k == "ConcatTransform") {
-    Transform x = from_pbrt_matrix(d.loc, numbers(d, a, 16, true));
+    Transform x = from_pbrt_matrix(d.loc, numbers(d, lx, 16, true));
     if (k == "Transform")
       gs_.ctm = x;
     else
       post(x);
   } else if (k == "CoordinateSystem") {
-    size_t i = 0;
-    std::string name = one_string(d, a, i);
-    if (i != a.size()) fail(a[i].loc, fmt::format("{}: unexpected {}", k, describe(a[i])));
+    std::string name = one_string(d, lx);
+    no_args();
     coord_systems_[name] = gs_.ctm;
   } else if (k == "CoordSysTransform") {
-    size_t i = 0;
-    std::string name = one_string(d, a, i);
-    if (i != a.size()) fail(a[i].loc, fmt::format("{}: unexpected {}", k, describe(a[i])));
+    std::string name = one_string(d, lx);
+    no_args();
     auto it = coord_systems_.find(name);
     if (it == coord_systems_.end())
       warn(d.loc, fmt::format("CoordSysTransform: unknown coordinate system \"{}\" ignored",
@@ -928,25 +956,26 @@ void Reader::directive(const Token& d, const std::vector<Token>& a,
         "TransformTimes"};
     if (!typed.count(k)) {
       warn(d.loc, fmt::format("unknown directive '{}' ignored", printable(k)));
+      skip();
       return;
     }
     if (k == "Texture" || k == "MakeNamedMedium" || k == "MediumInterface" || k == "Attribute" ||
         k == "ActiveTransform" || k == "TransformTimes" || k == "PixelFilter" ||
         k == "Accelerator" || k == "ColorSpace") {
       warn(d.loc, fmt::format("{} is not read in this slice, ignored", k));
+      skip();
       return;
     }
-    size_t i = 0;
-    std::string type = one_string(d, a, i);
+    std::string type = one_string(d, lx);
     if (k == "NamedMaterial") {
-      if (i != a.size()) fail(a[i].loc, fmt::format("{}: unexpected {}", k, describe(a[i])));
+      no_args();
       auto it = named_materials_.find(type);
       if (it == named_materials_.end())
         fail(d.loc, fmt::format("NamedMaterial: unknown material \"{}\"", printable(type)));
       gs_.material = it->second;
       return;
     }
-    Params p(*this, parse_params(a, i), fmt::format("{} \"{}\"", k, printable(type, 40)));
+    Params p(*this, parse_params(lx), fmt::format("{} \"{}\"", k, printable(type, 40)));
     if (k == "Camera") {
       need_world(false);
       camera(d, p, type);
@@ -1051,6 +1080,9 @@ void Reader::finish_camera(const Loc& loc) {
   if (!ok) fail(camera_set_ ? camera_loc_ : loc, "Camera: the camera transform is singular");
   double3 pos = wfc.t;
   double3 fwd = linear(wfc, {0, 0, 1}), up = linear(wfc, {0, 1, 0}), right = linear(wfc, {1, 0, 0});
+  if (!(len3(fwd) > 0.0 && len3(up) > 0.0 && len3(right) > 0.0) ||
+      !std::isfinite(len3(fwd) + len3(up) + len3(right) + dot3(pos, pos)))
+    fail(camera_set_ ? camera_loc_ : loc, "Camera: the camera transform is out of range");
   // Handedness (the format page, "Cameras", and pbrt-v4's PerspectiveCamera): in camera space
   // pbrt looks down +z with +y up, and raster x grows with camera +x. That frame is left-handed:
   // +x = cross(+y, +z). Canopy's camera (host/render/camera.cpp) puts raster x along
@@ -1494,8 +1526,8 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
     float r = roughness();
     double eta = kDefaultPlasticIor;
     if (Param* q = p.find("eta")) {
-      if (q->type == "float" && q->nums.size() == 1) {
-        eta = q->nums[0];
+      if (q->type == "float") {
+        eta = p.get_float("eta", kDefaultPlasticIor);
         if (!(eta >= 1.0 && eta <= kMaxPlasticIor))
           fail(q->loc,
                fmt::format("{}: \"float eta\": must be in [1, {}]", p.what(), kMaxPlasticIor));
