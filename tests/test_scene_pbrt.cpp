@@ -240,6 +240,20 @@ TEST(ScenePbrt, AreaLightMakesEmissiveTrianglesWithLTimesScaleAndTwoSided) {
   EXPECT_EQ(s.triangle_light[1], -1); // the area light ends with its attribute scope
 }
 
+// A one-sided emitter that faces pbrt's camera faces Canopy's camera too, whether or not the
+// reader mirrors the world (the winding is swapped with the reflection).
+TEST(ScenePbrt, OneSidedEmitterFacingTheCameraStillFacesIt) {
+  for (const char* pre : {"", "Scale -1 1 1\n"}) {
+    Scene s = load(std::string(pre) + "LookAt 2 1 5  0 0 0  0 1 0\nCamera \"perspective\"\n" +
+                   "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n" +
+                   tri_at("0 0 0  1 0 0  0 1 0")); // normal +z, towards the eye
+    ASSERT_EQ(s.lights.size(), 1u);
+    float3 n = xyz_of(s.lights[0].n);
+    float3 to_eye = s.camera.position - xyz_of(s.lights[0].p);
+    EXPECT_GT(dot(n, to_eye), 0.0f) << pre;
+  }
+}
+
 TEST(ScenePbrt, SphereAndDiskAreaLightsAreAnalytic) {
   Scene s = load(std::string(kKeptCamera) + "WorldBegin\n" +
                  "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n" +

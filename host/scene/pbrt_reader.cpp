@@ -425,6 +425,11 @@ public:
   std::optional<float3> spectrum(std::string_view name, Use use, std::string* named = nullptr);
   // Unknown parameters: one warning each.
   void finish();
+  // Marks every parameter read (a directive skipped as a whole warns once, not per parameter).
+  void mark_all_used() {
+    for (Param& p : ps_)
+      p.used = true;
+  }
 
 private:
   Reader& r_;
@@ -1343,7 +1348,11 @@ void Reader::light_source(const Token& d, Params& p, const std::string& type) {
          fmt::format("LightSource \"{}\" is not read in this slice, ignored", printable(type)));
     return;
   }
-  if (object_) fail(d.loc, "LightSource inside ObjectBegin");
+  if (object_) {
+    warn(d.loc, "LightSource inside ObjectBegin (not instanced) ignored");
+    p.mark_all_used();
+    return;
+  }
   if (Param* q = p.find("power")) {
     warn(q->loc, fmt::format("{}: \"power\" given: Canopy does not rescale lights to a power; "
                              "the light is skipped, ignored",
