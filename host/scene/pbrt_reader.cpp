@@ -371,7 +371,7 @@ public:
     fail(p.loc, fmt::format("{}: \"{} {}\": wrong parameter type (want {})", what_, p.type,
                             printable(p.name), want));
   }
-  // One value of `type` (or of one of `alt`), else nullptr.
+  // The parameter `name` if given, checked to hold one value of one of `types`; else nullptr.
   Param* one(std::string_view name, std::initializer_list<std::string_view> types) {
     Param* p = find(name);
     if (!p) return nullptr;
@@ -386,10 +386,6 @@ public:
     return p;
   }
   double get_float(std::string_view name, double def);
-  int get_int(std::string_view name, int def) {
-    Param* p = one(name, {"integer"});
-    return p ? int(p->nums[0]) : def;
-  }
   bool get_bool(std::string_view name, bool def) {
     Param* p = one(name, {"bool"});
     return p ? p->strs[0] == "true" : def;
@@ -399,7 +395,7 @@ public:
     if (!p) return std::nullopt;
     return p->strs[0];
   }
-  // An array of numbers of one of `types` (empty if absent).
+  // The numbers of `name`, checked to be of one of `types`; nullptr if absent.
   const std::vector<double>* get_nums(std::string_view name,
                                       std::initializer_list<std::string_view> types) {
     Param* p = find(name);
@@ -418,6 +414,8 @@ public:
            fmt::format("{}: \"{}\": wrong count of values ({}; want 3)", what_, name, v->size()));
     return double3{(*v)[0], (*v)[1], (*v)[2]};
   }
+  // Illuminant: the spectrum of a light, normalised as pbrt-v4 does; Reflectance: any other value
+  // (reflectances, conductor indices), used as it is.
   enum class Use { Reflectance, Illuminant };
   // A spectrum-valued parameter as RGB (the format page, "Spectra"); nullopt if absent or not
   // read (a texture or a named spectrum: warned, the caller's default applies). A named spectrum
