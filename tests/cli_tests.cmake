@@ -185,3 +185,23 @@ add_test(NAME cli_film_overflow_is_counted_and_finite
           -DWORK=${CMAKE_CURRENT_BINARY_DIR}/film_overflow
           -P ${CMAKE_CURRENT_SOURCE_DIR}/check_film_overflow.cmake)
 set_tests_properties(cli_film_overflow_is_counted_and_finite PROPERTIES LABELS cli TIMEOUT 180)
+
+# ---------------------------------------------------------------- pbrt-v4 scenes (the first slice)
+set(CANOPY_PBRT_DATA ${CMAKE_CURRENT_SOURCE_DIR}/data/pbrt)
+# A small .pbrt scene renders (the extension selects the pbrt reader).
+canopy_cli_test(cli_pbrt_render_small
+  "-DARGS=render|${CANOPY_PBRT_DATA}/small.pbrt|--spp|1|--quiet|--out|${CANOPY_SCRATCH}/pbrt_small.exr"
+  "-DNOT_STDERR=warning" "-DFILES=${CANOPY_SCRATCH}/pbrt_small.exr" -P ${CANOPY_CHECK_CLI})
+# A construct the reader skips: a one-line warning naming file:line, and the render goes on.
+canopy_cli_test(cli_pbrt_warning
+  "-DARGS=render|${CANOPY_PBRT_DATA}/warn.pbrt|--spp|1|--quiet|--out|${CANOPY_SCRATCH}/pbrt_warn.exr"
+  "-DSTDERR=canopy: warning: ${CANOPY_PBRT_DATA}/warn.pbrt:6: LightSource \"distant\" is not read in this slice, ignored"
+  -P ${CANOPY_CHECK_CLI})
+# --strict: the same warning is an error, exit 2, one line.
+canopy_cli_test(cli_pbrt_strict -DSCENE=${CANOPY_PBRT_DATA}/warn.pbrt "-DARGS=--strict"
+  "-DEXPECT=${CANOPY_PBRT_DATA}/warn.pbrt:6: LightSource \"distant\" is not read in this slice, ignored (--strict: warnings are errors)"
+  -P ${CANOPY_CHECK2})
+# An Include cycle: exit 2, the cycle named.
+canopy_cli_test(cli_pbrt_include_cycle -DSCENE=${CANOPY_PBRT_DATA}/cycle_a.pbrt
+  "-DEXPECT=${CANOPY_PBRT_DATA}/cycle_b.pbrt:2: Include cycle: ${CANOPY_PBRT_DATA}/cycle_a.pbrt -> ${CANOPY_PBRT_DATA}/cycle_b.pbrt -> ${CANOPY_PBRT_DATA}/cycle_a.pbrt"
+  -P ${CANOPY_CHECK2})

@@ -60,6 +60,7 @@ struct RenderArgs {
   std::string out, png, device, stats_json, heatmap, emitter_mask;
   bool stats = false;
   bool quiet = false;
+  bool strict = false; // scene warnings are errors
 };
 
 // Render progress on stderr, once a render has run for a second: a bar redrawn in place on a
@@ -235,7 +236,9 @@ std::string sampler_summary(const IntegratorSettings& in, bool orientation_term)
 
 int run_render(const RenderArgs& args) {
   auto t_start = std::chrono::steady_clock::now();
-  Scene scene = load_scene(args.scene);
+  Scene scene = load_scene(args.scene, SceneLoadOptions{args.strict});
+  for (const std::string& w : scene.warnings)
+    std::fprintf(stderr, "canopy: warning: %s\n", w.c_str());
   RunTimings timings;
   timings.load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -462,7 +465,7 @@ int main(int argc, char** argv) {
 
   RenderArgs rargs;
   CLI::App* render = app.add_subcommand("render", "Render a scene to EXR and PNG");
-  render->add_option("scene", rargs.scene, "Scene file (JSON, see docs/scene-format.md)")
+  render->add_option("scene", rargs.scene, "Scene file (JSON or .pbrt; docs/scene-format.md)")
       ->required();
   render->add_option("--spp", rargs.spp, "Samples per pixel (overrides the scene)");
   render->add_option("--samples", rargs.samples,
@@ -472,6 +475,8 @@ int main(int argc, char** argv) {
                      "x0,y0,x1,y1 renders the film's pixels [x0, x1) x [y0, y1) only, the same as "
                      "in the full render (a tile for `canopy merge`)");
   render->add_flag("--quiet", rargs.quiet, "No progress report");
+  render->add_flag("--strict", rargs.strict,
+                   "Scene warnings (pbrt constructs not read, unknown parameters) are errors");
   render->add_option("--out", rargs.out,
                      "Output image: FILE.exr, or FILE.png; the other format is written beside it "
                      "with the other extension (default out/<scene>.exr). Written to a temporary "

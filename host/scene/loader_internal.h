@@ -174,6 +174,9 @@ std::string check_coordinate(float3 p, double3 origin = {});
 // outside ...".
 std::string check_light_extent(const Light& l, double3 origin);
 
+// Empty if every vertex of s.vertices[first_vertex..] is within the coordinate range, else the
+// problem with the first one outside, "vertex N after the transform: ..." (N counted from 1).
+std::string vertices_problem(const Scene& s, size_t first_vertex);
 // Fails at `at` if a vertex of s.vertices[first_vertex..] is outside the coordinate range;
 // `what` starts the problem text (e.g. "instance 3: ").
 void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,

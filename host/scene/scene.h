@@ -178,13 +178,22 @@ struct Scene {
   bool has_medium = false;
   Medium medium{};
   size_t skipped_lights = 0; // lights given with zero emission, not in `lights`
+  // Input the loader read but could not map exactly (a pbrt-v4 construct Canopy lacks, an unknown
+  // parameter), one line each, "<file>:<line>: ... ignored". The JSON loader never warns (it
+  // refuses instead); the CLI prints these on stderr.
+  std::vector<std::string> warnings;
 
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
-// Loads and validates a scene file. Relative paths inside (OBJ files) are resolved against the
-// scene file's directory. Throws SceneError on any invalid input.
-Scene load_scene(const std::filesystem::path& file);
+struct SceneLoadOptions {
+  bool strict = false; // every warning is a SceneError instead (canopy render --strict)
+};
+
+// Loads and validates a scene file: a file ending in .pbrt is read as a pbrt-v4 scene
+// (pbrt_reader.h), anything else as JSON. Relative paths inside (OBJ files, pbrt Includes) are
+// resolved against the including file's directory. Throws SceneError on any invalid input.
+Scene load_scene(const std::filesystem::path& file, const SceneLoadOptions& options = {});
 
 // Same, from a JSON string; `name` is used in messages and `base_dir` resolves relative paths.
 Scene load_scene_from_string(const std::string& json_text, const std::string& name,

@@ -1,6 +1,7 @@
 // load_scene / load_scene_from_string: the top level of the scene format (docs/scene-format.md).
 #include "scene/loader_internal.h"
 #include "scene/metal_presets.h"
+#include "scene/pbrt_reader.h"
 
 #include <fmt/format.h>
 
@@ -179,11 +180,16 @@ size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
   return first_tri;
 }
 
-void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,
-                    std::string_view what) {
+std::string vertices_problem(const Scene& s, size_t first_vertex) {
   for (size_t i = first_vertex; i < s.vertices.size(); ++i)
     if (auto e = check_coordinate(s.vertices[i], s.origin); !e.empty())
-      at.fail(fmt::format("{}vertex {} after the transform: {}", what, i - first_vertex + 1, e));
+      return fmt::format("vertex {} after the transform: {}", i - first_vertex + 1, e);
+  return {};
+}
+
+void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,
+                    std::string_view what) {
+  if (auto e = vertices_problem(s, first_vertex); !e.empty()) at.fail(fmt::format("{}{}", what, e));
 }
 
 bool emits(const Light& l) {
@@ -427,7 +433,8 @@ Scene load_scene_from_string(const std::string& json_text, const std::string& na
   }
 }
 
-Scene load_scene(const std::filesystem::path& file) {
+Scene load_scene(const std::filesystem::path& file, const SceneLoadOptions& options) {
+  if (file.extension() == ".pbrt") return load_pbrt_scene(file, options);
   std::string name = printable(file.string(), 1024);
   std::string text = detail::read_input_file(file, kMaxSceneFileBytes, name + ": ");
   Scene s = load_scene_from_string(text, name, file.parent_path());

@@ -1,0 +1,1606 @@
+// pbrt-v4 scene files (https://pbrt.org/fileformat-v4; "the format page" below), first slice:
+// tokenizer, attribute/transform state, Include/Import, object instances (flattened), the
+// perspective camera, film/sampler/integrator settings, triangle/bilinear meshes, spheres and
+// disks, point/spot/diffuse area lights, and diffuse/conductor/coateddiffuse materials. Everything
+// else is skipped with a one-line warning naming file:line (docs/scene-format.md, "pbrt-v4
+// scenes"). The result is the same canopy::Scene the JSON loader builds: geometry goes through
+// Builder::add_mesh (transformed in double, rebased to the camera position, rounded once) and
+// lights through the helpers of lights.cpp.
+#include "scene/pbrt_reader.h"
+
+#include "scene/loader_internal.h"
+#include "scene/metal_presets.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <map>
+#include <optional>
+#include <set>
+#include <string_view>
+#include <vector>
+
+namespace canopy {
+
+// ------------------------------------------------------------------------------------ blackbody
+
+namespace {
+
+// CIE 1931 2-degree colour matching functions, the multi-lobe piecewise-Gaussian fit of C. Wyman,
+// P.-P. Sloan and P. Shirley, "Simple Analytic Approximations to the CIE XYZ Color Matching
+// Functions", JCGT 2(2), 2013, Eq. 2-4 (within a few percent of the tabulated functions, far
+// below what three RGB channels keep of a spectrum).
+double lobe(double l, double mu, double s1, double s2) {
+  double t = (l - mu) / (l < mu ? s1 : s2);
+  return std::exp(-0.5 * t * t);
+}
+double cie_x(double l) {
+  return 1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) -
+         0.065 * lobe(l, 501.1, 20.4, 26.2);
+}
+double cie_y(double l) {
+  return 0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1);
+}
+double cie_z(double l) {
+  return 1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8);
+}
+
+// Planck's law (pbrt-v4 Blackbody()), spectral radiance at wavelength `nm`.
+double planck(double nm, double kelvin) {
+  const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
+  double l = nm * 1e-9;
+  double e = std::expm1((h * c) / (l * kb * kelvin));
+  if (!std::isfinite(e)) return 0.0;
+  return (2.0 * h * c * c) / (std::pow(l, 5) * e);
+}
+
+} // namespace
+
+float3 blackbody_rgb(double kelvin) {
+  // pbrt-v4 BlackbodySpectrum: B(lambda, T) / B(lambda_max, T), Wien's displacement law giving
+  // lambda_max; XYZ as pbrt's SpectrumToXYZ (1 nm steps over 360..830 nm, divided by the y-bar
+  // integral), then XYZ -> linear sRGB (IEC 61966-2-1 matrix).
+  if (!(kelvin > 0.0) || !std::isfinite(kelvin)) return make_float3(0, 0, 0);
+  double peak = planck(2.8977721e-3 / kelvin * 1e9, kelvin);
+  if (!(peak > 0.0) || !std::isfinite(peak)) return make_float3(0, 0, 0);
+  double X = 0, Y = 0, Z = 0, yint = 0;
+  for (int nm = 360; nm <= 830; ++nm) {
+    double l = double(nm), b = planck(l, kelvin) / peak;
+    X += cie_x(l) * b;
+    Y += cie_y(l) * b;
+    Z += cie_z(l) * b;
+    yint += cie_y(l);
+  }
+  X /= yint;
+  Y /= yint;
+  Z /= yint;
+  double r = 3.2404542 * X - 1.5371385 * Y - 0.4985314 * Z;
+  double g = -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z;
+  double bl = 0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z;
+  return make_float3(float(std::max(r, 0.0)), float(std::max(g, 0.0)), float(std::max(bl, 0.0)));
+}
+
+namespace {
+
+using namespace detail;
+
+constexpr int kMaxIncludeDepth = 64;
+constexpr size_t kMaxWarnings = 100; // kept in Scene::warnings; the rest are counted
+// Flattened instances copy triangles: a few directives could ask for 10^12 of them. The cap keeps
+// memory to a few GiB and turns such a file into an error instead of an out-of-memory kill.
+constexpr size_t kMaxTriangles = size_t(1) << 27;
+// Tessellation of spheres and disks that are not analytic lights (Canopy has no analytic
+// sphere/disk primitive apart from its lights): smooth shading normals hide the facets.
+constexpr int kSphereRings = 24, kSphereSegments = 48, kDiskSegments = 64;
+
+// --------------------------------------------------------------------------------- tokenizer
+
+struct Loc {
+  const std::string* file = nullptr;
+  int line = 0;
+};
+
+[[noreturn]] void fail(const Loc& loc, std::string_view msg) {
+  throw SceneError(fmt::format("{}:{}: {}", *loc.file, loc.line, msg));
+}
+
+enum class Tok { String, Number, LBracket, RBracket, Ident };
+
+struct Token {
+  Tok kind;
+  std::string text; // string content, identifier, or the number as written
+  double num = 0.0;
+  Loc loc;
+};
+
+bool is_bool_ident(const Token& t) {
+  return t.kind == Tok::Ident && (t.text == "true" || t.text == "false");
+}
+
+// The format page, "Basic structure": '#' starts a comment to the end of the line; strings are
+// double-quoted on one line; numbers, brackets and bare identifiers (directives, true/false)
+// are separated by white space. Tokens are made one at a time as the reader asks for them, so a
+// mesh of N numbers costs N doubles, not N tokens.
+class Lexer {
+public:
+  Lexer(const std::string& text, const std::string* file) : text_(text), file_(file) {}
+  // The next token, or nullptr at the end of the text.
+  const Token* peek() {
+    if (!has_) has_ = lex(tok_);
+    return has_ ? &tok_ : nullptr;
+  }
+  // Consumes and returns the next token; the caller has checked peek().
+  Token next() {
+    peek();
+    has_ = false;
+    return std::move(tok_);
+  }
+  // True at the end of the text or at the next directive (an identifier other than true/false).
+  bool at_directive() {
+    const Token* t = peek();
+    return !t || (t->kind == Tok::Ident && !is_bool_ident(*t));
+  }
+  Loc here() const { return {file_, line_}; }
+
+private:
+  bool lex(Token& out);
+
+  const std::string& text_;
+  const std::string* file_;
+  size_t i_ = 0;
+  int line_ = 1;
+  Token tok_{Tok::Ident, {}, 0.0, {}};
+  bool has_ = false;
+};
+
+bool Lexer::lex(Token& out) {
+  const std::string& text = text_;
+  size_t& i = i_;
+  const size_t n = text.size();
+  auto delim = [](char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '[' || c == ']' || c == '"' ||
+           c == '#';
+  };
+  while (i < n) {
+    char c = text[i];
+    const Loc loc{file_, line_};
+    if (c == '\n') {
+      ++line_;
+      ++i;
+    } else if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
+      ++i;
+    } else if (c == '#') {
+      while (i < n && text[i] != '\n')
+        ++i;
+    } else if (c == '[' || c == ']') {
+      out = {c == '[' ? Tok::LBracket : Tok::RBracket, std::string(1, c), 0.0, loc};
+      ++i;
+      return true;
+    } else if (c == '"') {
+      out = {Tok::String, {}, 0.0, loc};
+      ++i;
+      bool closed = false;
+      while (i < n) {
+        char d = text[i++];
+        if (d == '"') {
+          closed = true;
+          break;
+        }
+        if (d == '\n') break;
+        if (d == '\\' && i < n && text[i] != '\n') {
+          char e = text[i++];
+          d = e == 'n' ? '\n' : e == 't' ? '\t' : e == 'r' ? '\r' : e == 'b' ? '\b' : e;
+        }
+        out.text.push_back(d);
+      }
+      if (!closed) fail(loc, "unterminated string");
+      return true;
+    } else if ((c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.') {
+      size_t j = i;
+      while (j < n && !delim(text[j]))
+        ++j;
+      out = {Tok::Number, text.substr(i, j - i), 0.0, loc};
+      std::string_view sv(out.text);
+      if (!sv.empty() && sv[0] == '+') sv.remove_prefix(1);
+      double v = 0.0;
+      auto r = std::from_chars(sv.data(), sv.data() + sv.size(), v);
+      if (sv.empty() || r.ec != std::errc() || r.ptr != sv.data() + sv.size())
+        fail(loc, fmt::format("bad number '{}'", printable(out.text)));
+      if (!std::isfinite(v)) fail(loc, fmt::format("number '{}' is not finite", out.text));
+      out.num = v;
+      i = j;
+      return true;
+    } else if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_') {
+      size_t j = i;
+      while (j < n && (std::isalnum(static_cast<unsigned char>(text[j])) || text[j] == '_'))
+        ++j;
+      out = {Tok::Ident, text.substr(i, j - i), 0.0, loc};
+      i = j;
+      return true;
+    } else {
+      fail(loc, fmt::format("unexpected character '{}'", printable(text.substr(i, 1))));
+    }
+  }
+  return false;
+}
+
+std::string describe(const Token& t) {
+  switch (t.kind) {
+  case Tok::String:
+    return fmt::format("\"{}\"", printable(t.text, 40));
+  case Tok::Number:
+    return t.text;
+  case Tok::LBracket:
+    return "[";
+  case Tok::RBracket:
+    return "]";
+  default:
+    return printable(t.text, 40);
+  }
+}
+
+// -------------------------------------------------------------------------------- parameters
+
+// One "type name" value list of a directive (the format page, "Parameter lists").
+struct Param {
+  std::string type, name;
+  Loc loc;
+  std::vector<double> nums;
+  std::vector<std::string> strs; // string, texture, bool and named-spectrum values
+  bool used = false;
+};
+
+bool is_numeric_type(const std::string& t) {
+  static const std::set<std::string> k = {"integer", "float",   "point2",  "vector2",
+                                          "point3",  "vector3", "normal3", "normal",
+                                          "point",   "vector",  "rgb",     "blackbody"};
+  return k.count(t) > 0;
+}
+
+// Reads the parameter list up to the next directive; checks each value against its declared
+// type.
+std::vector<Param> parse_params(Lexer& lx) {
+  std::vector<Param> ps;
+  while (!lx.at_directive()) {
+    const Token d = lx.next();
+    if (d.kind != Tok::String)
+      fail(d.loc, fmt::format("expected a parameter \"type name\", got {}", describe(d)));
+    Param p;
+    p.loc = d.loc;
+    {
+      size_t s0 = d.text.find_first_not_of(" \t");
+      size_t s1 = s0 == std::string::npos ? s0 : d.text.find_first_of(" \t", s0);
+      size_t s2 = s1 == std::string::npos ? s1 : d.text.find_first_not_of(" \t", s1);
+      size_t s3 = s2 == std::string::npos ? s2 : d.text.find_first_of(" \t", s2);
+      if (s2 == std::string::npos ||
+          (s3 != std::string::npos && d.text.find_first_not_of(" \t", s3) != std::string::npos))
+        fail(d.loc, fmt::format("expected a parameter \"type name\", got {}", describe(d)));
+      p.type = d.text.substr(s0, s1 - s0);
+      p.name = d.text.substr(s2, s3 == std::string::npos ? std::string::npos : s3 - s2);
+    }
+    static const std::set<std::string> types = {
+        "integer", "float",  "point2", "vector2",   "point3",   "vector3", "normal3", "normal",
+        "point",   "vector", "rgb",    "blackbody", "spectrum", "bool",    "string",  "texture"};
+    if (!types.count(p.type))
+      fail(d.loc, fmt::format("\"{} {}\": unknown parameter type '{}'", printable(p.type),
+                              printable(p.name), printable(p.type)));
+    for (const Param& q : ps)
+      if (q.name == p.name)
+        fail(d.loc, fmt::format("parameter '{}' given twice", printable(p.name)));
+    const std::string pn = fmt::format("\"{} {}\"", p.type, printable(p.name));
+    // The kind of the values (numbers or strings) is set by the type, and for "spectrum" by the
+    // first value (wavelength-value pairs or a named spectrum).
+    int numeric = is_numeric_type(p.type) ? 1 : p.type == "spectrum" ? -1 : 0;
+    auto take = [&](const Token& v) {
+      if (numeric < 0) numeric = v.kind == Tok::Number ? 1 : 0;
+      if (numeric) {
+        if (v.kind != Tok::Number)
+          fail(v.loc, fmt::format("{}: expected a number, got {}", pn, describe(v)));
+        if (p.type == "integer" && (v.num != std::floor(v.num) || std::fabs(v.num) > 2147483647.0))
+          fail(v.loc, fmt::format("{}: '{}' is not an integer", pn, v.text));
+        p.nums.push_back(v.num);
+      } else if (p.type == "bool") {
+        if (!(v.kind == Tok::String || is_bool_ident(v)) || (v.text != "true" && v.text != "false"))
+          fail(v.loc, fmt::format("{}: expected true or false, got {}", pn, describe(v)));
+        p.strs.push_back(v.text);
+      } else {
+        if (v.kind != Tok::String)
+          fail(v.loc, fmt::format("{}: expected a quoted string, got {}", pn, describe(v)));
+        p.strs.push_back(v.text);
+      }
+    };
+    if (lx.at_directive())
+      fail(d.loc, fmt::format("parameter '{}' has no value", printable(p.name)));
+    if (lx.peek()->kind == Tok::LBracket) {
+      lx.next();
+      while (true) {
+        if (lx.at_directive()) fail(d.loc, fmt::format("{}: '[' without ']'", pn));
+        Token v = lx.next();
+        if (v.kind == Tok::RBracket) break;
+        if (v.kind == Tok::LBracket) fail(v.loc, "'[' inside a value list");
+        take(v);
+      }
+    } else if (lx.peek()->kind == Tok::RBracket) {
+      fail(lx.peek()->loc, "']' without '['");
+    } else {
+      take(lx.next());
+    }
+    size_t cnt = numeric ? p.nums.size() : p.strs.size();
+    if (cnt == 0) fail(d.loc, fmt::format("{}: no values", pn));
+    auto want = [&](bool ok, std::string_view what) {
+      if (!ok) fail(d.loc, fmt::format("{}: wrong count of values ({}; {})", pn, cnt, what));
+    };
+    if (p.type == "rgb") want(cnt == 3, "want 3");
+    if (p.type == "blackbody") want(cnt == 1, "want 1 temperature");
+    if (p.type == "point2" || p.type == "vector2") want(cnt % 2 == 0, "want pairs");
+    if (p.type == "point3" || p.type == "vector3" || p.type == "normal3" || p.type == "normal" ||
+        p.type == "point" || p.type == "vector")
+      want(cnt % 3 == 0, "want triples");
+    if (p.type == "spectrum")
+      want(numeric ? cnt % 2 == 0 : cnt == 1, numeric ? "want wavelength-value pairs" : "want 1");
+    if (p.type == "bool") want(cnt == 1, "want 1");
+    ps.push_back(std::move(p));
+  }
+  return ps;
+}
+
+class Reader;
+
+// A directive's parameters with typed getters. A parameter read with the wrong type is an error;
+// one never read is reported by finish() as an unknown parameter.
+class Params {
+public:
+  Params(Reader& r, std::vector<Param> ps, std::string what)
+      : r_(r), ps_(std::move(ps)), what_(std::move(what)) {}
+  const std::string& what() const { return what_; }
+
+  Param* find(std::string_view name) {
+    for (Param& p : ps_)
+      if (p.name == name) {
+        p.used = true;
+        return &p;
+      }
+    return nullptr;
+  }
+  [[noreturn]] void wrong_type(const Param& p, std::string_view want) const {
+    fail(p.loc, fmt::format("{}: \"{} {}\": wrong parameter type (want {})", what_, p.type,
+                            printable(p.name), want));
+  }
+  // The parameter `name` if given, checked to hold one value of one of `types`; else nullptr.
+  Param* one(std::string_view name, std::initializer_list<std::string_view> types) {
+    Param* p = find(name);
+    if (!p) return nullptr;
+    bool ok = false;
+    for (auto t : types)
+      ok = ok || p->type == t;
+    if (!ok) wrong_type(*p, *types.begin());
+    size_t cnt = p->nums.empty() ? p->strs.size() : p->nums.size();
+    if (cnt != 1)
+      fail(p->loc, fmt::format("{}: \"{} {}\": wrong count of values ({}; want 1)", what_, p->type,
+                               printable(p->name), cnt));
+    return p;
+  }
+  double get_float(std::string_view name, double def);
+  bool get_bool(std::string_view name, bool def) {
+    Param* p = one(name, {"bool"});
+    return p ? p->strs[0] == "true" : def;
+  }
+  std::optional<std::string> get_string(std::string_view name) {
+    Param* p = one(name, {"string"});
+    if (!p) return std::nullopt;
+    return p->strs[0];
+  }
+  // The numbers of `name`, checked to be of one of `types`; nullptr if absent.
+  const std::vector<double>* get_nums(std::string_view name,
+                                      std::initializer_list<std::string_view> types) {
+    Param* p = find(name);
+    if (!p) return nullptr;
+    bool ok = false;
+    for (auto t : types)
+      ok = ok || p->type == t;
+    if (!ok) wrong_type(*p, *types.begin());
+    return &p->nums;
+  }
+  std::optional<double3> get_point(std::string_view name) {
+    const auto* v = get_nums(name, {"point3", "point"});
+    if (!v) return std::nullopt;
+    if (v->size() != 3)
+      fail(find(name)->loc,
+           fmt::format("{}: \"{}\": wrong count of values ({}; want 3)", what_, name, v->size()));
+    return double3{(*v)[0], (*v)[1], (*v)[2]};
+  }
+  // Illuminant: the spectrum of a light, normalised as pbrt-v4 does; Reflectance: any other value
+  // (reflectances, conductor indices), used as it is.
+  enum class Use { Reflectance, Illuminant };
+  // A spectrum-valued parameter as RGB (the format page, "Spectra"); nullopt if absent or not
+  // read (a texture or a named spectrum: warned, the caller's default applies). A named spectrum
+  // the caller handles itself (metal-*) is returned in `named`.
+  std::optional<float3> spectrum(std::string_view name, Use use, std::string* named = nullptr);
+  // Unknown parameters: one warning each.
+  void finish();
+  // Marks every parameter read (a directive skipped as a whole warns once, not per parameter).
+  void mark_all_used() {
+    for (Param& p : ps_)
+      p.used = true;
+  }
+
+private:
+  Reader& r_;
+  std::vector<Param> ps_;
+  std::string what_;
+};
+
+// ------------------------------------------------------------------------------------- reader
+
+struct GState {
+  Transform ctm; // pbrt's current transformation matrix: object space -> world
+  int material = 0;
+  bool reverse = false; // ReverseOrientation
+  bool area = false;    // an AreaLightSource "diffuse" applies to the shapes
+  float3 area_L{0, 0, 0};
+  bool area_twosided = false;
+};
+
+struct ObjectPart {
+  Mesh mesh;
+  Transform xf; // the shape's CTM at its definition (object -> instance space)
+};
+
+class Reader {
+public:
+  Reader(Scene& s, const std::string& name, const std::filesystem::path& base,
+         const SceneLoadOptions& o)
+      : scene_(s), b_{s, name, base, {}, {}, {}}, opt_(o) {}
+
+  void warn(const Loc& loc, const std::string& msg) {
+    std::string line = fmt::format("{}:{}: {}", *loc.file, loc.line, msg);
+    if (opt_.strict) throw SceneError(line + " (--strict: warnings are errors)");
+    if (scene_.warnings.size() < kMaxWarnings)
+      scene_.warnings.push_back(printable(line, 400));
+    else
+      ++dropped_warnings_;
+  }
+
+  void run_file(const std::filesystem::path& file, const std::string& display, const Loc* from);
+  void run_text(const std::string& text, const std::string& display,
+                const std::filesystem::path& dir);
+  void finish();
+
+private:
+  void directive(const Token& d, Lexer& lx, const std::filesystem::path& dir);
+
+  // Directive parts.
+  std::vector<double> numbers(const Token& d, Lexer& lx, size_t want, bool brackets_ok);
+  std::string one_string(const Token& d, Lexer& lx);
+  void camera(const Token& d, Params& p, const std::string& type);
+  void finish_camera(const Loc& loc);
+  void shape(const Token& d, Params& p, const std::string& type);
+  void light_source(const Token& d, Params& p, const std::string& type);
+  void area_light(const Token& d, Params& p, const std::string& type);
+  int material(const Loc& loc, Params& p, const std::string& type, const std::string& name);
+  void add_mesh(const Loc& loc, Mesh& m, const Transform& ctm);
+  Transform world(const Transform& ctm) const { return ctm.then(world_fix_); }
+
+  Scene& scene_;
+  Builder b_;
+  SceneLoadOptions opt_;
+  std::deque<std::string> names_;                                  // file names the tokens point at
+  std::vector<std::pair<std::string, std::string>> include_stack_; // canonical, display
+  GState gs_;
+  struct Pushed {
+    GState gs;
+    Loc loc;
+    std::string kind; // "AttributeBegin", "ObjectBegin", "TransformBegin"
+  };
+  std::vector<Pushed> stack_;
+  std::map<std::string, Transform> coord_systems_;
+  std::map<std::string, int> named_materials_;
+  std::map<std::string, std::vector<ObjectPart>> objects_;
+  std::vector<ObjectPart>* object_ = nullptr; // inside ObjectBegin
+  bool world_block_ = false;
+  bool camera_set_ = false;
+  Loc camera_loc_;
+  Transform camera_from_world_;
+  double fov_ = 90.0; // pbrt's default
+  Transform world_fix_;
+  size_t dropped_warnings_ = 0;
+  Loc last_loc_; // the last directive read, for problems found at the end
+
+  friend class Params;
+
+public:
+  size_t dropped_warnings() const { return dropped_warnings_; }
+};
+
+std::optional<float3> Params::spectrum(std::string_view name, Use use, std::string* named) {
+  Param* p = find(name);
+  if (!p) return std::nullopt;
+  const std::string pn = fmt::format("{}: \"{} {}\"", what_, p->type, printable(p->name));
+  if (p->type == "rgb") {
+    float3 c = to_float3({p->nums[0], p->nums[1], p->nums[2]});
+    if (!(c.x >= 0.0f && c.y >= 0.0f && c.z >= 0.0f))
+      fail(p->loc, fmt::format("{}: must be >= 0", pn));
+    if (!std::isfinite(c.x + c.y + c.z)) fail(p->loc, fmt::format("{}: is too large", pn));
+    return c;
+  }
+  if (p->type == "blackbody") {
+    double t = p->nums[0];
+    if (!(t > 0.0)) fail(p->loc, fmt::format("{}: the temperature must be > 0", pn));
+    float3 c = blackbody_rgb(t);
+    if (use == Use::Illuminant) {
+      // pbrt-v4 divides every light's scale by SpectrumToPhotometric(spectrum) ("scale so that
+      // radiance is equivalent to 1 nit", lights.cpp): a blackbody emitter has luminance 1. An
+      // "rgb" emitter is divided by its illuminant's (the colour space's white) luminance only,
+      // so its RGB passes through unchanged.
+      float y = 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+      c = y > 0.0f ? c * (1.0f / y) : make_float3(0, 0, 0);
+    }
+    return c;
+  }
+  if (p->type == "spectrum") {
+    if (named && !p->strs.empty()) {
+      *named = p->strs[0];
+      return std::nullopt;
+    }
+    r_.warn(p->loc,
+            fmt::format("{}: spectra are not read in this slice (white used), ignored", pn));
+    return make_float3(1, 1, 1);
+  }
+  if (p->type == "texture") {
+    r_.warn(p->loc, fmt::format("{}: textures are not read in this slice (the constant default "
+                                "used), ignored",
+                                pn));
+    return std::nullopt;
+  }
+  wrong_type(*p, "rgb, blackbody or spectrum");
+}
+
+double Params::get_float(std::string_view name, double def) {
+  Param* p = find(name);
+  if (p && p->type == "texture") {
+    r_.warn(p->loc, fmt::format("{}: \"texture {}\": textures are not read in this slice (the "
+                                "constant default used), ignored",
+                                what_, printable(p->name)));
+    return def;
+  }
+  p = one(name, {"float"});
+  return p ? p->nums[0] : def;
+}
+
+void Params::finish() {
+  for (const Param& p : ps_)
+    if (!p.used)
+      r_.warn(p.loc, fmt::format("{}: unknown parameter \"{} {}\" ignored", what_, p.type,
+                                 printable(p.name)));
+}
+
+// ----------------------------------------------------------------------------- transforms
+
+Transform inverse(const Transform& x, bool& ok) {
+  const auto& a = x.m;
+  double c[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      c[i][j] = a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1];
+    }
+  double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+  Transform r;
+  ok = det != 0.0 && std::isfinite(det);
+  if (!ok) return r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      r.m[i][j] = c[j][i] / det;
+  double3 t = x.t;
+  r.t = {-(r.m[0][0] * t.x + r.m[0][1] * t.y + r.m[0][2] * t.z),
+         -(r.m[1][0] * t.x + r.m[1][1] * t.y + r.m[1][2] * t.z),
+         -(r.m[2][0] * t.x + r.m[2][1] * t.y + r.m[2][2] * t.z)};
+  return r;
+}
+
+double3 linear(const Transform& x, double3 v) {
+  return {x.m[0][0] * v.x + x.m[0][1] * v.y + x.m[0][2] * v.z,
+          x.m[1][0] * v.x + x.m[1][1] * v.y + x.m[1][2] * v.z,
+          x.m[2][0] * v.x + x.m[2][1] * v.y + x.m[2][2] * v.z};
+}
+double dot3(double3 a, double3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+double3 cross3(double3 a, double3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+double len3(double3 a) {
+  return std::sqrt(dot3(a, a));
+}
+
+// The uniform scale of x if its linear part is a similarity (rotation, reflection and uniform
+// scale), else 0: spheres and disks stay round only under those.
+double similarity_scale(const Transform& x) {
+  double3 c[3] = {linear(x, {1, 0, 0}), linear(x, {0, 1, 0}), linear(x, {0, 0, 1})};
+  double s2 = dot3(c[0], c[0]);
+  if (!(s2 > 0.0) || !std::isfinite(s2)) return 0.0;
+  for (int i = 0; i < 3; ++i) {
+    if (std::fabs(dot3(c[i], c[i]) / s2 - 1.0) > 1e-6) return 0.0;
+    if (std::fabs(dot3(c[i], c[(i + 1) % 3])) / s2 > 1e-6) return 0.0;
+  }
+  return std::sqrt(s2);
+}
+
+// pbrt's 4x4 matrices are written column by column (the format page, "Transformations": the
+// translation is elements 12..14); the last row must be 0 0 0 1 for an affine transform.
+Transform from_pbrt_matrix(const Loc& loc, const std::vector<double>& v) {
+  Transform x;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j)
+      x.m[i][j] = v[size_t(4 * j + i)];
+  }
+  x.t = {v[12], v[13], v[14]};
+  if (v[3] != 0.0 || v[7] != 0.0 || v[11] != 0.0 || v[15] != 1.0)
+    fail(loc, "projective matrices are not supported (the last row must be 0 0 0 1)");
+  return x;
+}
+
+// ------------------------------------------------------------------------------------ shapes
+
+void reverse_winding(Mesh& m) {
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
+    if (!m.normal_indices.empty())
+      std::swap(m.normal_indices[3 * t + 1], m.normal_indices[3 * t + 2]);
+  }
+}
+
+// pbrt-v4 Triangle/BilinearPatch: with vertex normals the geometric normal is turned towards the
+// shading normal (FaceForward), whatever the winding or ReverseOrientation. Canopy's emission and
+// geometric normal follow the winding, so the winding is turned instead (the vertex normals'
+// sum standing in for the interpolated one).
+void face_forward_to_normals(Mesh& m) {
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    const float3 a = m.vertices[m.indices[3 * t]], b = m.vertices[m.indices[3 * t + 1]],
+                 c = m.vertices[m.indices[3 * t + 2]];
+    double3 ng = cross3(dvec(b - a), dvec(c - a));
+    double3 ns{};
+    for (int k = 0; k < 3; ++k)
+      ns = ns + dvec(m.normals[size_t(m.normal_indices[3 * t + size_t(k)])]);
+    if (dot3(ng, ns) < 0.0) {
+      std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
+      std::swap(m.normal_indices[3 * t + 1], m.normal_indices[3 * t + 2]);
+    }
+  }
+}
+
+Mesh sphere_mesh(float radius) {
+  Mesh m;
+  const int nr = kSphereRings, ns = kSphereSegments;
+  const double pi = 3.14159265358979323846;
+  // Poles plus (nr - 1) rings; normals are the unit positions.
+  m.vertices.push_back(make_float3(0, 0, radius));
+  m.normals.push_back(make_float3(0, 0, 1));
+  for (int i = 1; i < nr; ++i) {
+    double th = pi * i / nr;
+    for (int j = 0; j < ns; ++j) {
+      double ph = 2.0 * pi * j / ns;
+      float3 n = make_float3(float(std::sin(th) * std::cos(ph)), float(std::sin(th) * std::sin(ph)),
+                             float(std::cos(th)));
+      m.vertices.push_back(n * radius);
+      m.normals.push_back(n);
+    }
+  }
+  m.vertices.push_back(make_float3(0, 0, -radius));
+  m.normals.push_back(make_float3(0, 0, -1));
+  const uint32_t south = uint32_t(m.vertices.size() - 1);
+  auto ring = [&](int i, int j) { return uint32_t(1 + (i - 1) * ns + ((j % ns) + ns) % ns); };
+  auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
+    m.add_triangle(a, b, c, 0, make_float3(0, 0, 0));
+    m.normal_indices.insert(m.normal_indices.end(), {int32_t(a), int32_t(b), int32_t(c)});
+  };
+  // Counter-clockwise seen from outside: the winding normal points out, as pbrt's sphere normal.
+  for (int j = 0; j < ns; ++j)
+    tri(0, ring(1, j), ring(1, j + 1));
+  for (int i = 1; i < nr - 1; ++i)
+    for (int j = 0; j < ns; ++j) {
+      tri(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1));
+      tri(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1));
+    }
+  for (int j = 0; j < ns; ++j)
+    tri(ring(nr - 1, j), south, ring(nr - 1, j + 1));
+  return m;
+}
+
+// pbrt's disk: radius r at z = height, normal +z (pbrt-v4 Disk).
+Mesh disk_mesh(float radius, float height) {
+  Mesh m;
+  const double pi = 3.14159265358979323846;
+  m.vertices.push_back(make_float3(0, 0, height));
+  for (int j = 0; j < kDiskSegments; ++j) {
+    double ph = 2.0 * pi * j / kDiskSegments;
+    m.vertices.push_back(
+        make_float3(float(radius * std::cos(ph)), float(radius * std::sin(ph)), height));
+  }
+  for (int j = 0; j < kDiskSegments; ++j)
+    m.add_triangle(0, uint32_t(1 + j), uint32_t(1 + (j + 1) % kDiskSegments), 0,
+                   make_float3(0, 0, 0));
+  return m;
+}
+
+// ---------------------------------------------------------------------------- the reader proper
+
+void Reader::run_file(const std::filesystem::path& file, const std::string& display,
+                      const Loc* from) {
+  std::error_code ec;
+  std::string canon = std::filesystem::weakly_canonical(file, ec).string();
+  if (ec) canon = file.lexically_normal().string();
+  for (size_t k = 0; k < include_stack_.size(); ++k)
+    if (include_stack_[k].first == canon) {
+      std::string chain;
+      for (size_t m = k; m < include_stack_.size(); ++m)
+        chain += include_stack_[m].second + " -> ";
+      fail(*from, fmt::format("Include cycle: {}{}", chain, display));
+    }
+  if (include_stack_.size() >= size_t(kMaxIncludeDepth))
+    fail(*from, fmt::format("Includes nested deeper than {}", kMaxIncludeDepth));
+  std::string prefix =
+      from ? fmt::format("{}:{}: Include \"{}\": ", *from->file, from->line, display)
+           : display + ": ";
+  std::string text = read_input_file(file, kMaxSceneFileBytes, prefix);
+  include_stack_.push_back({canon, display});
+  run_text(text, display, file.parent_path());
+  include_stack_.pop_back();
+}
+
+void Reader::run_text(const std::string& text, const std::string& display,
+                      const std::filesystem::path& dir) {
+  names_.push_back(display);
+  Lexer lx(text, &names_.back());
+  while (lx.peek()) {
+    const Token d = lx.next();
+    if (d.kind != Tok::Ident || is_bool_ident(d))
+      fail(d.loc, fmt::format("expected a directive, got {}", describe(d)));
+    last_loc_ = d.loc;
+    directive(d, lx, dir);
+  }
+}
+
+std::vector<double> Reader::numbers(const Token& d, Lexer& lx, size_t want, bool brackets_ok) {
+  std::vector<double> v;
+  const bool br = brackets_ok && lx.peek() && lx.peek()->kind == Tok::LBracket;
+  if (br) lx.next();
+  while (v.size() <= want) { // one more than wanted is enough to report the count
+    if (br && lx.peek() && lx.peek()->kind == Tok::RBracket) {
+      lx.next();
+      break;
+    }
+    if (lx.at_directive()) {
+      if (br) fail(d.loc, fmt::format("{}: '[' without ']'", d.text));
+      break;
+    }
+    Token t = lx.next();
+    if (t.kind != Tok::Number)
+      fail(t.loc, fmt::format("{}: expected a number, got {}", d.text, describe(t)));
+    v.push_back(t.num);
+  }
+  if (v.size() != want)
+    fail(d.loc, fmt::format("{}: wrong count of values ({}{}; want {} numbers)", d.text,
+                            v.size() > want ? "more than " : "", std::min(v.size(), want), want));
+  if (!lx.at_directive())
+    fail(lx.peek()->loc, fmt::format("{}: unexpected {}", d.text, describe(*lx.peek())));
+  return v;
+}
+
+std::string Reader::one_string(const Token& d, Lexer& lx) {
+  const Token* t = lx.peek();
+  if (!t || t->kind != Tok::String)
+    fail(t && !lx.at_directive() ? t->loc : d.loc,
+         fmt::format("{}: expected a quoted name{}", d.text,
+                     t && !lx.at_directive() ? ", got " + describe(*t) : ""));
+  return lx.next().text;
+}
+
+void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& dir) {
+  const std::string& k = d.text;
+  auto no_args = [&] {
+    if (!lx.at_directive())
+      fail(lx.peek()->loc, fmt::format("{}: unexpected {}", k, describe(*lx.peek())));
+  };
+  auto skip = [&] { // the arguments of a directive that is not read
+    while (!lx.at_directive())
+      lx.next();
+  };
+  auto need_world = [&](bool inside) {
+    if (world_block_ != inside)
+      fail(d.loc, fmt::format("{} is not allowed {} WorldBegin", k, inside ? "before" : "after"));
+  };
+  auto post = [&](const Transform& x) { gs_.ctm = x.then(gs_.ctm); }; // CTM = CTM * x
+
+  // ---- structure (the format page, "Scene-wide rendering options" / "Attributes")
+  if (k == "Include" || k == "Import") {
+    // Import may only add named things in pbrt-v4 (it exists so files can be parsed in
+    // parallel); read sequentially, it is the same as Include.
+    std::string f = one_string(d, lx);
+    no_args();
+    std::filesystem::path p(f);
+    if (p.is_relative()) p = dir / p;
+    run_file(p, p.lexically_normal().string(), &d.loc);
+  } else if (k == "AttributeBegin" || k == "TransformBegin") {
+    // TransformBegin/End: deprecated in pbrt-v4 but accepted there; they save the CTM only.
+    no_args();
+    stack_.push_back({gs_, d.loc, k});
+  } else if (k == "AttributeEnd" || k == "TransformEnd") {
+    no_args();
+    const char* open = k == "AttributeEnd" ? "AttributeBegin" : "TransformBegin";
+    if (stack_.empty() || stack_.back().kind != open)
+      fail(d.loc, stack_.empty() ? fmt::format("{} without {}", k, open)
+                                 : fmt::format("{} closes the {} of line {}", k, stack_.back().kind,
+                                               stack_.back().loc.line));
+    if (k == "AttributeEnd")
+      gs_ = stack_.back().gs;
+    else
+      gs_.ctm = stack_.back().gs.ctm;
+    stack_.pop_back();
+  } else if (k == "WorldBegin") {
+    no_args();
+    need_world(false);
+    finish_camera(d.loc);
+    world_block_ = true;
+    gs_.ctm = Transform{};
+    coord_systems_["world"] = Transform{};
+  } else if (k == "ReverseOrientation") {
+    no_args();
+    gs_.reverse = !gs_.reverse;
+  } else if (k == "Option") {
+    warn(d.loc, "Option: rendering options are not read, ignored");
+    skip();
+  } else if (k == "ObjectBegin") {
+    // Object instances are flattened: each ObjectInstance copies the object's triangles with the
+    // instance transform into the one triangle soup (Canopy's BVH has no instance level). Memory
+    // grows with instances x triangles, capped by kMaxTriangles.
+    need_world(true);
+    std::string name = one_string(d, lx);
+    no_args();
+    if (object_) fail(d.loc, "ObjectBegin inside another ObjectBegin");
+    if (objects_.count(name))
+      fail(d.loc, fmt::format("object \"{}\" is defined twice", printable(name)));
+    stack_.push_back({gs_, d.loc, "ObjectBegin"}); // pbrt-v4: ObjectBegin implies AttributeBegin
+    object_ = &objects_[name];
+  } else if (k == "ObjectEnd") {
+    no_args();
+    if (!object_ || stack_.empty() || stack_.back().kind != "ObjectBegin")
+      fail(d.loc, stack_.empty() || !object_
+                      ? std::string("ObjectEnd without ObjectBegin")
+                      : fmt::format("ObjectEnd closes the {} of line {}", stack_.back().kind,
+                                    stack_.back().loc.line));
+    gs_ = stack_.back().gs;
+    stack_.pop_back();
+    object_ = nullptr;
+  } else if (k == "ObjectInstance") {
+    need_world(true);
+    std::string name = one_string(d, lx);
+    no_args();
+    if (object_) fail(d.loc, "ObjectInstance inside ObjectBegin");
+    auto it = objects_.find(name);
+    if (it == objects_.end()) fail(d.loc, fmt::format("unknown object \"{}\"", printable(name)));
+    for (ObjectPart& part : it->second)
+      add_mesh(d.loc, part.mesh, part.xf.then(gs_.ctm));
+  }
+  // ---- transforms (the format page, "Transformations"); pbrt post-multiplies the CTM
+  else if (k == "Identity") {
+    no_args();
+    gs_.ctm = Transform{};
+  } else if (k == "Translate") {
+    auto v = numbers(d, lx, 3, false);
+    post(Transform::translate({v[0], v[1], v[2]}));
+  } else if (k == "Scale") {
+    auto v = numbers(d, lx, 3, false);
+    post(Transform::scale({v[0], v[1], v[2]}));
+  } else if (k == "Rotate") {
+    auto v = numbers(d, lx, 4, false);
+    double3 ax{v[1], v[2], v[3]};
+    double l = len3(ax);
+    if (!(l > 0.0) || !std::isfinite(l)) fail(d.loc, "Rotate: the axis must be non-zero");
+    post(Transform::rotate(ax * (1.0 / l), v[0]));
+  } else if (k == "LookAt") {
+    auto v = numbers(d, lx, 9, false);
+    double3 eye{v[0], v[1], v[2]}, at{v[3], v[4], v[5]}, up{v[6], v[7], v[8]};
+    double3 dirv = at - eye;
+    double dl = len3(dirv), ul = len3(up);
+    if (!(dl > 0.0) || !std::isfinite(dl)) fail(d.loc, "LookAt: eye and target coincide");
+    if (!(ul > 0.0) || !std::isfinite(ul)) fail(d.loc, "LookAt: the up vector is zero");
+    dirv = dirv * (1.0 / dl);
+    // pbrt-v4 LookAt: right = normalize(cross(normalize(up), dir)), newUp = cross(dir, right);
+    // worldFromCamera has columns right, newUp, dir and the eye; the CTM gets its inverse.
+    double3 right = cross3(up * (1.0 / ul), dirv);
+    double rl = len3(right);
+    if (!(rl > 1e-9)) fail(d.loc, "LookAt: the up vector is parallel to the view direction");
+    right = right * (1.0 / rl);
+    double3 nup = cross3(dirv, right);
+    Transform cam_from_world; // the transpose of the rotation, then minus the rotated eye
+    double3 rows[3] = {right, nup, dirv};
+    for (int i = 0; i < 3; ++i) {
+      cam_from_world.m[i][0] = rows[i].x;
+      cam_from_world.m[i][1] = rows[i].y;
+      cam_from_world.m[i][2] = rows[i].z;
+    }
+    cam_from_world.t = {-dot3(right, eye), -dot3(nup, eye), -dot3(dirv, eye)};
+    post(cam_from_world);
+  } else if (k == "Transform" || k == "ConcatTransform") {
+    Transform x = from_pbrt_matrix(d.loc, numbers(d, lx, 16, true));
+    if (k == "Transform")
+      gs_.ctm = x;
+    else
+      post(x);
+  } else if (k == "CoordinateSystem") {
+    std::string name = one_string(d, lx);
+    no_args();
+    coord_systems_[name] = gs_.ctm;
+  } else if (k == "CoordSysTransform") {
+    std::string name = one_string(d, lx);
+    no_args();
+    auto it = coord_systems_.find(name);
+    if (it == coord_systems_.end())
+      warn(d.loc, fmt::format("CoordSysTransform: unknown coordinate system \"{}\" ignored",
+                              printable(name)));
+    else
+      gs_.ctm = it->second;
+  }
+  // ---- everything with a type name and a parameter list
+  else {
+    static const std::set<std::string> typed = {
+        "Camera",          "Film",        "Sampler",
+        "Integrator",      "PixelFilter", "Accelerator",
+        "ColorSpace",      "Shape",       "LightSource",
+        "AreaLightSource", "Material",    "MakeNamedMaterial",
+        "NamedMaterial",   "Texture",     "MakeNamedMedium",
+        "MediumInterface", "Attribute",   "ActiveTransform",
+        "TransformTimes"};
+    if (!typed.count(k)) {
+      warn(d.loc, fmt::format("unknown directive '{}' ignored", printable(k)));
+      skip();
+      return;
+    }
+    if (k == "Texture" || k == "MakeNamedMedium" || k == "MediumInterface" || k == "Attribute" ||
+        k == "ActiveTransform" || k == "TransformTimes" || k == "PixelFilter" ||
+        k == "Accelerator" || k == "ColorSpace") {
+      warn(d.loc, fmt::format("{} is not read in this slice, ignored", k));
+      skip();
+      return;
+    }
+    std::string type = one_string(d, lx);
+    if (k == "NamedMaterial") {
+      no_args();
+      auto it = named_materials_.find(type);
+      if (it == named_materials_.end())
+        fail(d.loc, fmt::format("NamedMaterial: unknown material \"{}\"", printable(type)));
+      gs_.material = it->second;
+      return;
+    }
+    Params p(*this, parse_params(lx), fmt::format("{} \"{}\"", k, printable(type, 40)));
+    if (k == "Camera") {
+      need_world(false);
+      camera(d, p, type);
+    } else if (k == "Film") {
+      need_world(false);
+      if (type != "rgb")
+        warn(d.loc, fmt::format("Film \"{}\": read as \"rgb\" (its other outputs ignored)",
+                                printable(type)));
+      auto res = [&](const char* name, int& out) {
+        if (Param* q = p.one(name, {"integer"})) {
+          double v = q->nums[0];
+          if (!(v >= 1 && v <= kMaxFilmSide))
+            fail(q->loc, fmt::format("{}: \"integer {}\": must be in [1, {}]", p.what(), name,
+                                     kMaxFilmSide));
+          out = int(v);
+        }
+      };
+      res("xresolution", scene_.film.width);
+      res("yresolution", scene_.film.height);
+      if (auto f = p.get_string("filename"))
+        warn(p.find("filename")->loc,
+             fmt::format("{}: \"string filename\" \"{}\": the output is --out (default "
+                         "out/<scene>.exr), ignored",
+                         p.what(), printable(*f)));
+      p.finish();
+    } else if (k == "Sampler") {
+      need_world(false);
+      if (Param* q = p.one("pixelsamples", {"integer"})) {
+        if (!(q->nums[0] >= 1 && q->nums[0] <= kMaxSpp))
+          fail(q->loc,
+               fmt::format("{}: \"integer pixelsamples\": must be in [1, {}]", p.what(), kMaxSpp));
+        scene_.integrator.spp = int(q->nums[0]);
+      }
+      p.finish();
+    } else if (k == "Integrator") {
+      need_world(false);
+      // "path" and "volpath" are what Canopy renders (paths with light sampling and MIS, pbrt's
+      // maxdepth); any other integrator is replaced by it.
+      if (type != "path" && type != "volpath")
+        warn(d.loc, fmt::format("Integrator \"{}\": rendered with Canopy's path tracer, the "
+                                "integrator ignored",
+                                printable(type)));
+      if (Param* q = p.one("maxdepth", {"integer"})) {
+        if (!(q->nums[0] >= 1 && q->nums[0] <= kMaxDepth))
+          fail(q->loc,
+               fmt::format("{}: \"integer maxdepth\": must be in [1, {}]", p.what(), kMaxDepth));
+        scene_.integrator.max_depth = int(q->nums[0]);
+      }
+      p.finish();
+    } else if (k == "Shape") {
+      need_world(true);
+      shape(d, p, type);
+    } else if (k == "LightSource") {
+      need_world(true);
+      light_source(d, p, type);
+    } else if (k == "AreaLightSource") {
+      need_world(true);
+      area_light(d, p, type);
+    } else if (k == "Material") {
+      need_world(true);
+      gs_.material = material(d.loc, p, type, "");
+    } else { // MakeNamedMaterial "name" "string type" "..." params
+      need_world(true);
+      auto t = p.get_string("type");
+      if (!t) fail(d.loc, "MakeNamedMaterial: needs a \"string type\" parameter");
+      if (named_materials_.count(type))
+        fail(d.loc, fmt::format("MakeNamedMaterial: \"{}\" is defined twice", printable(type)));
+      named_materials_[type] = material(d.loc, p, *t, type);
+    }
+  }
+}
+
+// The format page, "Cameras": the CTM at the Camera directive is camera-from-world, and the
+// "camera" coordinate system is its inverse.
+void Reader::camera(const Token& d, Params& p, const std::string& type) {
+  if (type != "perspective")
+    warn(d.loc, fmt::format("Camera \"{}\": read as \"perspective\" (its projection ignored)",
+                            printable(type)));
+  camera_set_ = true;
+  camera_loc_ = d.loc;
+  camera_from_world_ = gs_.ctm;
+  bool ok = false;
+  Transform wfc = inverse(gs_.ctm, ok);
+  if (!ok) fail(d.loc, "Camera: the camera transform is singular");
+  coord_systems_["camera"] = wfc;
+  if (Param* q = p.one("fov", {"float"})) {
+    if (!(q->nums[0] > 0.0 && q->nums[0] < 180.0))
+      fail(q->loc, fmt::format("{}: \"float fov\": must be in (0, 180)", p.what()));
+    fov_ = q->nums[0];
+  }
+  for (const char* lens : {"lensradius", "focaldistance"})
+    if (p.find(lens))
+      warn(p.find(lens)->loc,
+           fmt::format("{}: \"{}\": Canopy's camera is a pinhole (no thin lens), ignored", p.what(),
+                       lens));
+  p.finish();
+}
+
+void Reader::finish_camera(const Loc& loc) {
+  bool ok = false;
+  Transform wfc = inverse(camera_from_world_, ok); // identity without a Camera: pbrt's default
+  if (!ok) fail(camera_set_ ? camera_loc_ : loc, "Camera: the camera transform is singular");
+  double3 pos = wfc.t;
+  double3 fwd = linear(wfc, {0, 0, 1}), up = linear(wfc, {0, 1, 0}), right = linear(wfc, {1, 0, 0});
+  if (!(len3(fwd) > 0.0 && len3(up) > 0.0 && len3(right) > 0.0) ||
+      !std::isfinite(len3(fwd) + len3(up) + len3(right) + dot3(pos, pos)))
+    fail(camera_set_ ? camera_loc_ : loc, "Camera: the camera transform is out of range");
+  // Handedness (the format page, "Cameras", and pbrt-v4's PerspectiveCamera): in camera space
+  // pbrt looks down +z with +y up, and raster x grows with camera +x. That frame is left-handed:
+  // +x = cross(+y, +z). Canopy's camera (host/render/camera.cpp) puts raster x along
+  // cross(forward, up), a right-handed frame. So when worldFromCamera keeps orientation
+  // (det > 0: a plain LookAt, where camera +x = world cross(up, dir)) pbrt's image is the mirror
+  // of what Canopy would show from the same eye, and Canopy must render the mirrored world:
+  // every shape and light is reflected through the plane that holds the eye, the view direction
+  // and the up vector (world_fix_), which swaps the two sides of the image and nothing else.
+  // When worldFromCamera flips orientation (the common "Scale -1 1 1" before LookAt), the frames
+  // already agree and the world is kept as written.
+  double det = wfc.det();
+  if (det > 0.0) {
+    double rl = len3(right);
+    double3 n = right * (1.0 / rl);
+    Transform r; // p - 2 ((p - pos) . n) n
+    double nn[3] = {n.x, n.y, n.z};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        r.m[i][j] = (i == j ? 1.0 : 0.0) - 2.0 * nn[i] * nn[j];
+    r.t = n * (2.0 * dot3(pos, n));
+    world_fix_ = r;
+  }
+  // A camera transform with scale or shear changes pbrt's rays; Canopy's camera is a pinhole
+  // with an orthonormal frame: only the eye and the view and up directions are kept.
+  double3 cols[3] = {right, up, fwd};
+  bool ortho = true;
+  for (int i = 0; i < 3; ++i) {
+    ortho = ortho && std::fabs(len3(cols[i]) - 1.0) < 1e-6;
+    ortho = ortho && std::fabs(dot3(cols[i], cols[(i + 1) % 3])) < 1e-6;
+  }
+  if (!ortho)
+    warn(camera_set_ ? camera_loc_ : loc,
+         "Camera: the camera transform scales or shears (only the eye, view and up directions "
+         "are kept), the rest ignored");
+  if (auto e = check_coordinate(to_float3(pos)); !e.empty())
+    fail(camera_set_ ? camera_loc_ : loc, "Camera: the eye " + e);
+  scene_.origin = pos;
+  Camera& c = scene_.camera;
+  c.position = make_float3(0, 0, 0);
+  double fl = len3(fwd), ul = len3(up);
+  c.look_at = to_float3(fwd * (1.0 / fl));
+  c.up = to_float3(up * (1.0 / ul));
+  // pbrt's fov spans the shorter image axis (PerspectiveCamera: the screen window is
+  // [-1, 1] on the shorter axis); Canopy's fov_y_deg spans the vertical one. On a tall film the
+  // horizontal half-width is tan(fov/2), so the vertical one is tan(fov/2) * height / width.
+  const double d2r = 3.14159265358979323846 / 180.0;
+  double fy = fov_;
+  if (scene_.film.height > scene_.film.width)
+    fy = 2.0 *
+         std::atan(std::tan(0.5 * fov_ * d2r) * double(scene_.film.height) /
+                   double(scene_.film.width)) /
+         d2r;
+  c.fov_y_deg = float(fy);
+  if (!(c.fov_y_deg > 0.0f && c.fov_y_deg < 180.0f))
+    fail(camera_set_ ? camera_loc_ : loc, "Camera: the vertical field of view is out of range");
+}
+
+void Reader::finish() {
+  const Loc end = last_loc_.file ? last_loc_ : Loc{&names_.front(), 1};
+  if (!world_block_) finish_camera(end); // a file without WorldBegin: camera and options only
+  if (!stack_.empty())
+    warn(stack_.back().loc,
+         fmt::format("{} without its end at the end of the file, ignored", stack_.back().kind));
+  if (dropped_warnings_ > 0)
+    scene_.warnings.push_back(fmt::format("{}: {} more warnings", b_.file, dropped_warnings_));
+}
+
+void Reader::add_mesh(const Loc& loc, Mesh& m, const Transform& ctm) {
+  if (m.triangle_count() > kMaxTriangles - std::min(kMaxTriangles, scene_.triangle_count()))
+    fail(loc,
+         fmt::format("more than {} triangles (after flattening object instances)", kMaxTriangles));
+  Transform xf = world(ctm);
+  float det = to_float(xf.det());
+  if (!std::isfinite(det)) fail(loc, "the transform is too large (its determinant overflows)");
+  if (det == 0.0f) fail(loc, "the transform is degenerate (zero determinant)");
+  size_t first_vertex = scene_.vertices.size();
+  b_.add_mesh(m, xf);
+  if (auto e = vertices_problem(scene_, first_vertex); !e.empty()) fail(loc, e);
+}
+
+// The format page, "Shapes".
+void Reader::shape(const Token& d, Params& p, const std::string& type) {
+  const Loc& loc = d.loc;
+  Mesh m;
+  bool analytic_light_done = false;
+  // pbrt-v4 does not support area lights on instanced shapes either.
+  if (gs_.area && object_)
+    warn(loc, "an area light on a shape inside ObjectBegin (not supported with instancing) "
+              "ignored");
+  const bool area = gs_.area && !object_;
+  auto emission = [&] { return area ? gs_.area_L : make_float3(0, 0, 0); };
+  auto points = [&](const char* name, size_t min_count) -> std::vector<float3> {
+    const auto* v = p.get_nums(name, {"point3", "point"});
+    if (!v) fail(loc, fmt::format("{}: needs \"point3 {}\"", p.what(), name));
+    if (v->size() < 3 * min_count)
+      fail(p.find(name)->loc, fmt::format("{}: \"point3 {}\": wrong count of values ({}; want at "
+                                          "least {})",
+                                          p.what(), name, v->size(), 3 * min_count));
+    std::vector<float3> out;
+    for (size_t i = 0; i < v->size(); i += 3) {
+      float3 q = to_float3({(*v)[i], (*v)[i + 1], (*v)[i + 2]});
+      if (!std::isfinite(q.x + q.y + q.z))
+        fail(p.find(name)->loc,
+             fmt::format("{}: \"point3 {}\": a value is too large", p.what(), name));
+      out.push_back(q);
+    }
+    return out;
+  };
+  auto indices = [&](size_t per, size_t nverts) -> std::vector<uint32_t> {
+    const auto* v = p.get_nums("indices", {"integer"});
+    std::vector<uint32_t> out;
+    if (!v) {
+      if (nverts != per)
+        fail(loc, fmt::format("{}: needs \"integer indices\" (it has {} vertices, not {})",
+                              p.what(), nverts, per));
+      for (size_t i = 0; i < per; ++i)
+        out.push_back(uint32_t(i));
+      return out;
+    }
+    const Loc& il = p.find("indices")->loc;
+    if (v->empty() || v->size() % per != 0)
+      fail(il, fmt::format("{}: \"integer indices\": wrong count of values ({}; want a multiple "
+                           "of {})",
+                           p.what(), v->size(), per));
+    for (double x : *v) {
+      if (!(x >= 0 && x < double(nverts)))
+        fail(il, fmt::format("{}: \"integer indices\": {} is out of range [0, {})", p.what(), x,
+                             nverts));
+      out.push_back(uint32_t(x));
+    }
+    return out;
+  };
+  auto normals = [&](size_t nverts) {
+    const auto* v = p.get_nums("N", {"normal", "normal3"});
+    if (!v) return;
+    if (v->size() != 3 * nverts)
+      fail(p.find("N")->loc, fmt::format("{}: \"normal N\": wrong count of values ({}; want {}, "
+                                         "one per vertex)",
+                                         p.what(), v->size(), 3 * nverts));
+    for (size_t i = 0; i < v->size(); i += 3)
+      m.normals.push_back(to_float3({(*v)[i], (*v)[i + 1], (*v)[i + 2]}));
+  };
+
+  if (type == "trianglemesh" || type == "bilinearmesh") {
+    const bool tri = type == "trianglemesh";
+    m.vertices = points("P", tri ? 3 : 4);
+    std::vector<uint32_t> idx = indices(tri ? 3 : 4, m.vertices.size());
+    normals(m.vertices.size());
+    p.find("uv"); // texture coordinates: parsed (checked) but unused until textures are read
+    float3 em = emission();
+    auto add = [&](uint32_t x, uint32_t y, uint32_t z) {
+      m.add_triangle(x, y, z, gs_.material, em);
+      if (!m.normals.empty())
+        m.normal_indices.insert(m.normal_indices.end(), {int32_t(x), int32_t(y), int32_t(z)});
+    };
+    if (tri) {
+      for (size_t t = 0; t < idx.size(); t += 3)
+        add(idx[t], idx[t + 1], idx[t + 2]);
+    } else {
+      // pbrt-v4 BilinearPatch: vertices p00, p10, p01, p11; its normal is
+      // cross(p10 - p00, p01 - p00), which the triangles (p00 p10 p11) and (p00 p11 p01) keep.
+      for (size_t t = 0; t < idx.size(); t += 4) {
+        add(idx[t], idx[t + 1], idx[t + 3]);
+        add(idx[t], idx[t + 3], idx[t + 2]);
+      }
+    }
+    if (!m.normals.empty())
+      face_forward_to_normals(m);
+    else if (gs_.reverse)
+      reverse_winding(m);
+  } else if (type == "sphere" || type == "disk") {
+    const bool sph = type == "sphere";
+    double radius = p.get_float("radius", 1.0);
+    if (!(radius > 0.0) || !std::isfinite(float(radius)))
+      fail(loc, fmt::format("{}: \"float radius\": must be > 0", p.what()));
+    double height = 0.0;
+    if (sph) {
+      double zmin = p.get_float("zmin", -radius), zmax = p.get_float("zmax", radius);
+      double phimax = p.get_float("phimax", 360.0);
+      if (zmin > -radius || zmax < radius || phimax < 360.0)
+        warn(loc, fmt::format("{}: zmin/zmax/phimax (a partial sphere) ignored, full sphere "
+                              "used",
+                              p.what()));
+    } else {
+      height = p.get_float("height", 0.0);
+      if (p.get_float("innerradius", 0.0) != 0.0)
+        warn(p.find("innerradius")->loc,
+             fmt::format("{}: \"float innerradius\" (an annulus) ignored, full disk used",
+                         p.what()));
+      if (p.get_float("phimax", 360.0) < 360.0)
+        warn(
+            p.find("phimax")->loc,
+            fmt::format("{}: \"float phimax\" (a partial disk) ignored, full disk used", p.what()));
+    }
+    Transform xf = world(gs_.ctm);
+    double s = similarity_scale(xf);
+    if (area && s > 0.0) {
+      // Canopy has analytic sphere and disk lights: the emitter is exact and sampled by solid
+      // angle (sphere) or area (disk) instead of as a mesh of triangle lights.
+      Light l{};
+      l.prim = -1;
+      l.emission = f4_from3(gs_.area_L, 0.0f);
+      double3 c = xf.apply(double3{0, 0, height});
+      float r = to_float(radius * s);
+      if (!std::isfinite(r) || !(r > 0.0f))
+        fail(loc, "the radius after the transform is out of range");
+      l.p = f4_from3(rebase(c, scene_.origin), r);
+      if (sph) {
+        l.type = LIGHT_SPHERE;
+        if (gs_.reverse)
+          warn(loc, "ReverseOrientation on a sphere light (Canopy's emits outward) ignored");
+        if (gs_.area_twosided)
+          warn(loc, "\"bool twosided\" of a sphere light (Canopy's emits outward) ignored");
+      } else {
+        l.type = LIGHT_DISK;
+        l.flags = gs_.area_twosided ? LIGHT_FLAG_TWO_SIDED : 0;
+        float3 n = xf.apply_normal(make_float3(0, 0, 1));
+        if (gs_.reverse) n = n * -1.0f;
+        if (!finish_disk_light(l, n)) fail(loc, "disk light: area pi r^2 is out of range");
+      }
+      if (auto e = check_light_extent(l, scene_.origin); !e.empty()) fail(loc, e);
+      if (emits(l))
+        scene_.lights.push_back(l);
+      else
+        ++scene_.skipped_lights;
+      analytic_light_done = true;
+    } else {
+      m = sph ? sphere_mesh(float(radius)) : disk_mesh(float(radius), float(height));
+      float3 em = emission();
+      for (size_t t = 0; t < m.triangle_count(); ++t) {
+        m.material[t] = gs_.material;
+        m.emission[t] = em;
+      }
+      if (gs_.reverse) reverse_winding(m); // spheres keep their outward shading normals
+    }
+  } else {
+    warn(loc, fmt::format("Shape \"{}\" is not read in this slice{}, ignored", printable(type),
+                          type == "plymesh" ? " (PLY files come next)" : ""));
+    return;
+  }
+  for (const char* skip : {"alpha", "emissionfilename", "displacement"})
+    if (Param* q = p.find(skip))
+      warn(q->loc, fmt::format("{}: \"{} {}\" ignored", p.what(), q->type, skip));
+  p.finish();
+  if (analytic_light_done) return;
+  m.two_sided_emission = area && gs_.area_twosided;
+  if (object_) {
+    object_->push_back({std::move(m), gs_.ctm});
+    return;
+  }
+  add_mesh(loc, m, gs_.ctm);
+}
+
+// The format page, "Lights".
+void Reader::light_source(const Token& d, Params& p, const std::string& type) {
+  if (type != "point" && type != "spot") {
+    warn(d.loc,
+         fmt::format("LightSource \"{}\" is not read in this slice, ignored", printable(type)));
+    return;
+  }
+  if (object_) {
+    warn(d.loc, "LightSource inside ObjectBegin (not instanced) ignored");
+    p.mark_all_used();
+    return;
+  }
+  if (Param* q = p.find("power")) {
+    warn(q->loc, fmt::format("{}: \"power\" given: Canopy does not rescale lights to a power; "
+                             "the light is skipped, ignored",
+                             p.what()));
+    p.finish();
+    return;
+  }
+  float3 I = p.spectrum("I", Params::Use::Illuminant).value_or(make_float3(1, 1, 1));
+  double scale = p.get_float("scale", 1.0);
+  if (!(scale >= 0.0)) fail(d.loc, fmt::format("{}: \"float scale\": must be >= 0", p.what()));
+  float3 em = to_float3(dvec(I) * scale);
+  if (!std::isfinite(em.x + em.y + em.z))
+    fail(d.loc, fmt::format("{}: I * scale is too large", p.what()));
+  Transform xf = world(gs_.ctm);
+  double3 from = p.get_point("from").value_or(double3{0, 0, 0});
+  Light l{};
+  l.prim = -1;
+  l.emission = f4_from3(em, 0.0f);
+  l.p = f4_from3(rebase(xf.apply(from), scene_.origin), 0.0f);
+  if (type == "point") {
+    l.type = LIGHT_POINT;
+  } else {
+    l.type = LIGHT_SPOT;
+    double3 to = p.get_point("to").value_or(double3{0, 0, 1});
+    double3 dir = linear(xf, to - from);
+    double dl = len3(dir);
+    if (!(dl > 0.0) || !std::isfinite(dl))
+      fail(d.loc, fmt::format("{}: \"from\" and \"to\" must differ", p.what()));
+    l.e1 = f4_from3(to_float3(dir * (1.0 / dl)), 0.0f);
+    // pbrt-v4 SpotLight: full intensity inside coneangle - conedelta, a smoothstep in cos theta
+    // out to coneangle; Canopy's spot (cl/lights/light_sample.h spot_falloff) is the same
+    // smoothstep between its falloff start and its cone edge.
+    double cone = p.get_float("coneangle", 30.0), delta = p.get_float("conedelta", 5.0);
+    if (!(cone > 0.0 && cone <= 180.0))
+      fail(d.loc, fmt::format("{}: \"float coneangle\": must be in (0, 180]", p.what()));
+    if (!(delta >= 0.0))
+      fail(d.loc, fmt::format("{}: \"float conedelta\": must be >= 0", p.what()));
+    set_spot_cone(l, cone, std::clamp(cone - delta, 0.0, cone));
+  }
+  p.finish();
+  if (auto e = check_light_extent(l, scene_.origin); !e.empty()) fail(d.loc, e);
+  if (emits(l))
+    scene_.lights.push_back(l);
+  else
+    ++scene_.skipped_lights;
+}
+
+void Reader::area_light(const Token& d, Params& p, const std::string& type) {
+  if (type != "diffuse") {
+    warn(d.loc,
+         fmt::format("AreaLightSource \"{}\" is not read in this slice, ignored", printable(type)));
+    return;
+  }
+  float3 L = p.spectrum("L", Params::Use::Illuminant).value_or(make_float3(1, 1, 1));
+  double scale = p.get_float("scale", 1.0);
+  if (!(scale >= 0.0)) fail(d.loc, fmt::format("{}: \"float scale\": must be >= 0", p.what()));
+  bool two = p.get_bool("twosided", false);
+  if (Param* q = p.find("power"))
+    warn(q->loc, fmt::format("{}: \"power\" (Canopy does not rescale lights to a power) ignored",
+                             p.what()));
+  p.finish();
+  float3 em = to_float3(dvec(L) * scale);
+  if (!std::isfinite(em.x + em.y + em.z))
+    fail(d.loc, fmt::format("{}: L * scale is too large", p.what()));
+  if (object_) {
+    // pbrt-v4 does the same: "Area lights not supported with object instancing".
+    warn(d.loc, "AreaLightSource inside ObjectBegin (not supported with instancing) ignored");
+    return;
+  }
+  gs_.area = true;
+  gs_.area_L = em;
+  gs_.area_twosided = two;
+}
+
+// The format page, "Materials". Returns the index of the new scene material.
+int Reader::material(const Loc& loc, Params& p, const std::string& type, const std::string& name) {
+  // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha is alpha = sqrt(roughness), applied
+  // when remaproughness is true (the default); Canopy's roughness r means alpha = r^2
+  // (scene.h conductor_material). So Canopy's r is roughness^(1/4) when remapped and
+  // sqrt(roughness) otherwise. Alpha above 1 is beyond Canopy's range and is clamped.
+  auto roughness = [&]() -> float {
+    double r = p.get_float("roughness", 0.0);
+    Param* ur = p.find("uroughness");
+    Param* vr = p.find("vroughness");
+    double u = ur ? p.get_float("uroughness", r) : r, v = vr ? p.get_float("vroughness", r) : r;
+    if (u != v)
+      warn(ur ? ur->loc : vr->loc,
+           fmt::format("{}: uroughness {} != vroughness {}: Canopy's GGX is isotropic, their mean "
+                       "used, anisotropy ignored",
+                       p.what(), u, v));
+    double rr = 0.5 * (u + v);
+    if (!(rr >= 0.0)) fail(loc, fmt::format("{}: roughness must be >= 0", p.what()));
+    bool remap = p.get_bool("remaproughness", true);
+    double alpha = remap ? std::sqrt(rr) : rr;
+    if (alpha > 1.0) {
+      warn(loc,
+           fmt::format("{}: GGX alpha {} > 1 clamped to 1, the excess ignored", p.what(), alpha));
+      alpha = 1.0;
+    }
+    return float(std::sqrt(alpha));
+  };
+  auto albedo = [&](const char* key) {
+    float3 c = p.spectrum(key, Params::Use::Reflectance).value_or(make_float3(0.5f, 0.5f, 0.5f));
+    // pbrt-v4 clamps reflectances to [0, 1] (DiffuseMaterial, CoatedDiffuseMaterial).
+    return make_float3(std::min(c.x, 1.0f), std::min(c.y, 1.0f), std::min(c.z, 1.0f));
+  };
+  std::string mname = name.empty() ? fmt::format("pbrt:{}:{}", *loc.file, loc.line) : name;
+  for (const char* skip : {"displacement", "normalmap"})
+    if (Param* q = p.find(skip))
+      warn(q->loc, fmt::format("{}: \"{} {}\" ignored", p.what(), q->type, skip));
+  MaterialDesc md;
+  if (type == "diffuse") {
+    md = diffuse_material(mname, albedo("reflectance"));
+  } else if (type == "conductor") {
+    float r = roughness();
+    float3 eta, k;
+    if (p.find("reflectance")) {
+      // pbrt-v4 ConductorMaterial with "reflectance": eta = 1, k = 2 sqrt(r) / sqrt(1 - r),
+      // the index whose normal-incidence Fresnel reflectance is r.
+      float3 c = albedo("reflectance");
+      auto kk = [](float x) {
+        x = std::clamp(x, 0.0f, 0.9999f);
+        return 2.0f * std::sqrt(x) / std::sqrt(1.0f - x);
+      };
+      eta = make_float3(1, 1, 1);
+      k = make_float3(kk(c.x), kk(c.y), kk(c.z));
+    } else {
+      // Named spectra "metal-<X>-eta"/"metal-<X>-k" (pbrt-v4 spectrum.cpp) map to Canopy's
+      // measured presets (metal_presets.cpp); copper is pbrt's default conductor.
+      auto preset_of = [&](const std::string& spec, const char* which) -> const MetalPreset* {
+        static const std::map<std::string, std::string> m = {
+            {"Au", "gold"}, {"Ag", "silver"}, {"Cu", "copper"}, {"Al", "aluminium"}};
+        std::string pre = "metal-", suf = std::string("-") + which;
+        if (spec.size() > pre.size() + suf.size() && spec.rfind(pre, 0) == 0 &&
+            spec.compare(spec.size() - suf.size(), suf.size(), suf) == 0) {
+          auto it = m.find(spec.substr(pre.size(), spec.size() - pre.size() - suf.size()));
+          if (it != m.end()) return find_metal_preset(it->second);
+        }
+        warn(p.find(which)->loc,
+             fmt::format("{}: spectrum \"{}\" has no Canopy preset (gold, silver, copper, "
+                         "aluminium): copper used, the spectrum ignored",
+                         p.what(), printable(spec)));
+        return find_metal_preset("copper");
+      };
+      const MetalPreset* cu = find_metal_preset("copper");
+      eta = make_float3(cu->eta[0], cu->eta[1], cu->eta[2]);
+      k = make_float3(cu->k[0], cu->k[1], cu->k[2]);
+      std::string named;
+      if (auto e = p.spectrum("eta", Params::Use::Reflectance, &named)) {
+        eta = *e;
+      } else if (!named.empty()) {
+        const MetalPreset* pr = preset_of(named, "eta");
+        eta = make_float3(pr->eta[0], pr->eta[1], pr->eta[2]);
+      }
+      named.clear();
+      if (auto e = p.spectrum("k", Params::Use::Reflectance, &named)) {
+        k = *e;
+      } else if (!named.empty()) {
+        const MetalPreset* pr = preset_of(named, "k");
+        k = make_float3(pr->k[0], pr->k[1], pr->k[2]);
+      }
+      auto in = [](float3 c, float lo, float hi) {
+        return c.x >= lo && c.y >= lo && c.z >= lo && c.x <= hi && c.y <= hi && c.z <= hi;
+      };
+      if (!in(eta, kMinConductorEta, kMaxConductorIndex))
+        fail(loc, fmt::format("{}: eta must be in [{}, {}]", p.what(), kMinConductorEta,
+                              kMaxConductorIndex));
+      if (!in(k, 0.0f, kMaxConductorIndex))
+        fail(loc, fmt::format("{}: k must be in [0, {}]", p.what(), kMaxConductorIndex));
+    }
+    md = conductor_material(mname, r, eta, k);
+  } else if (type == "coateddiffuse") {
+    // pbrt-v4 CoatedDiffuse is a dielectric coat (index eta) over a Lambertian base, with light
+    // bouncing between the two simulated stochastically. Canopy's plastic is the same pair of
+    // lobes added without that coupling: the specular GGX lobe with the coat's Fresnel
+    // reflectance and roughness matches; the diffuse part is lighter and less saturated than
+    // pbrt's (which loses energy to the coat's internal reflection and tints it by repeated
+    // bounces). The coat medium (albedo, thickness, g) is not modelled.
+    float3 kd = albedo("reflectance");
+    float r = roughness();
+    double eta = kDefaultPlasticIor;
+    if (Param* q = p.find("eta")) {
+      if (q->type == "float") {
+        eta = p.get_float("eta", kDefaultPlasticIor);
+        if (!(eta >= 1.0 && eta <= kMaxPlasticIor))
+          fail(q->loc,
+               fmt::format("{}: \"float eta\": must be in [1, {}]", p.what(), kMaxPlasticIor));
+      } else {
+        warn(q->loc,
+             fmt::format("{}: a spectral \"eta\" ({} used) ignored", p.what(), kDefaultPlasticIor));
+      }
+    }
+    if (Param* q = p.find("albedo"))
+      warn(q->loc, fmt::format("{}: \"albedo\" of the coat medium ignored", p.what()));
+    for (const char* skip : {"thickness", "g", "maxdepth", "nsamples"})
+      if (Param* q = p.find(skip))
+        warn(q->loc, fmt::format("{}: \"{}\" (the coat's random walk) ignored", p.what(), skip));
+    md = plastic_material(mname, kd, make_float3(1, 1, 1), r, float(eta));
+  } else {
+    warn(loc, fmt::format("Material \"{}\" is not read in this slice (diffuse 0.5 used), ignored",
+                          printable(type)));
+    scene_.materials.push_back(diffuse_material(mname, make_float3(0.5f, 0.5f, 0.5f)));
+    return int(scene_.materials.size()) - 1;
+  }
+  p.find("type"); // MakeNamedMaterial's type is read by the caller
+  p.finish();
+  scene_.materials.push_back(md);
+  return int(scene_.materials.size()) - 1;
+}
+
+Scene load(const std::string& text, const std::string& name, const std::filesystem::path& dir,
+           const std::filesystem::path* file, const SceneLoadOptions& options) {
+  Scene scene;
+  scene.path = name;
+  // pbrt-v4's defaults: a 1280 x 720 film and a diffuse material of reflectance 0.5.
+  scene.film.width = 1280;
+  scene.film.height = 720;
+  scene.materials.push_back(diffuse_material("default", make_float3(0.5f, 0.5f, 0.5f)));
+  Reader r(scene, name, dir, options);
+  if (file)
+    r.run_file(*file, name, nullptr);
+  else
+    r.run_text(text, name, dir);
+  r.finish();
+  return scene;
+}
+
+Scene guarded(const std::string& name, const std::function<Scene()>& f) {
+  try {
+    return f();
+  } catch (const std::bad_alloc&) {
+    throw SceneError(fmt::format("{}: out of memory while building the scene", name));
+  } catch (const std::length_error&) {
+    throw SceneError(fmt::format("{}: out of memory while building the scene", name));
+  }
+}
+
+} // namespace
+
+Scene load_pbrt_scene(const std::filesystem::path& file, const SceneLoadOptions& options) {
+  std::string name = printable(file.string(), 1024);
+  Scene s = guarded(name, [&] { return load({}, name, file.parent_path(), &file, options); });
+  s.path = file;
+  return s;
+}
+
+Scene load_pbrt_scene_from_string(const std::string& text, const std::string& name,
+                                  const std::filesystem::path& base_dir,
+                                  const SceneLoadOptions& options) {
+  return guarded(name, [&] { return load(text, name, base_dir, nullptr, options); });
+}
+
+} // namespace canopy
