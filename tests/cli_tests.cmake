@@ -201,6 +201,11 @@ canopy_cli_test(cli_pbrt_warning
 canopy_cli_test(cli_pbrt_strict -DSCENE=${CANOPY_PBRT_DATA}/warn.pbrt "-DARGS=--strict"
   "-DEXPECT=${CANOPY_PBRT_DATA}/warn.pbrt:6: LightSource \"distant\" is not read in this slice, ignored (--strict: warnings are errors)"
   -P ${CANOPY_CHECK2})
+# The Film's filename is the default output (relative to the working directory, as pbrt writes it).
+canopy_cli_test(cli_pbrt_film_output
+  "-DARGS=render|${CANOPY_PBRT_DATA}/film_output.pbrt|--quiet"
+  "-DFILES=${CMAKE_CURRENT_BINARY_DIR}/pbrt_film_out.png|${CMAKE_CURRENT_BINARY_DIR}/pbrt_film_out.exr"
+  -P ${CANOPY_CHECK_CLI})
 # An Include cycle: exit 2, the cycle named.
 canopy_cli_test(cli_pbrt_include_cycle -DSCENE=${CANOPY_PBRT_DATA}/cycle_a.pbrt
   "-DEXPECT=${CANOPY_PBRT_DATA}/cycle_b.pbrt:2: Include cycle: ${CANOPY_PBRT_DATA}/cycle_a.pbrt -> ${CANOPY_PBRT_DATA}/cycle_b.pbrt -> ${CANOPY_PBRT_DATA}/cycle_a.pbrt"

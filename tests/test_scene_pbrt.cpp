@@ -131,6 +131,24 @@ TEST(ScenePbrt, FovOfTheShorterAxisBecomesTheVerticalFov) {
   EXPECT_NEAR(def.camera.fov_y_deg, 90.0, 1e-4);
 }
 
+// Film "filename" is the default output; scale x iso / 100 the image scale (pbrt-v4 RGBFilm's
+// imaging ratio for the default sensor); another extension than .exr/.png becomes .exr.
+TEST(ScenePbrt, FilmFilenameAndImageScale) {
+  Scene s = load("Film \"rgb\" \"string filename\" \"renders/room.png\" \"float iso\" 400 "
+                 "\"float scale\" 0.5\n");
+  EXPECT_EQ(s.film.output, "renders/room.png");
+  EXPECT_FLOAT_EQ(s.film.image_scale, 2.0f); // 0.5 x 400 / 100
+  EXPECT_TRUE(s.warnings.empty());
+  Scene def = load("Film \"rgb\"\n");
+  EXPECT_EQ(def.film.output, "");
+  EXPECT_FLOAT_EQ(def.film.image_scale, 1.0f);
+  Scene tga = load("Film \"rgb\" \"string filename\" \"a.tga\"\n");
+  EXPECT_EQ(tga.film.output, "a.exr");
+  ASSERT_EQ(tga.warnings.size(), 1u);
+  EXPECT_NE(tga.warnings[0].find("t.pbrt:1: "), std::string::npos) << tga.warnings[0];
+  EXPECT_NE(error_of("Film \"rgb\" \"float iso\" 0\n").find("t.pbrt:1: "), std::string::npos);
+}
+
 TEST(ScenePbrt, SamplerAndIntegratorSettings) {
   Scene s = load("Sampler \"zsobol\" \"integer pixelsamples\" 64\n"
                  "Integrator \"path\" \"integer maxdepth\" 7\n");

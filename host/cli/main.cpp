@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -149,11 +150,19 @@ std::string lower_ext(const fs::path& p) {
 
 // The EXR and PNG paths. --out names the EXR (FILE.exr) or the PNG (FILE.png); the other format is
 // written beside it with the other extension unless --png names the PNG. Each format is written
-// once, and never under the other's extension.
-std::pair<fs::path, fs::path> output_paths(const RenderArgs& args) {
+// once, and never under the other's extension. Without --out: the scene's own output
+// (`scene_output`, pbrt's Film "filename", .exr or .png), else out/<scene>.exr.
+std::pair<fs::path, fs::path> output_paths(const RenderArgs& args,
+                                           const std::string& scene_output) {
   fs::path stem = fs::path(args.scene).stem();
   fs::path exr, png;
-  if (args.out.empty()) {
+  if (args.out.empty() && !scene_output.empty()) {
+    exr = scene_output;
+    if (lower_ext(exr) == ".png") {
+      if (args.png.empty()) png = exr;
+      exr.replace_extension(".exr");
+    }
+  } else if (args.out.empty()) {
     exr = fs::path("out") / (stem.string() + ".exr");
   } else {
     fs::path out(args.out);
@@ -297,7 +306,7 @@ int run_render(const RenderArgs& args) {
   if (args.brdf_equal) scene.integrator.brdf_adaptive = false;
   if (args.volume_importance) scene.integrator.volume_importance = *args.volume_importance;
 
-  auto [exr, png] = output_paths(args);
+  auto [exr, png] = output_paths(args, scene.film.output);
   check_writable(exr, args.out.empty() ? "output" : "--out");
   check_writable(png, args.png.empty() ? "output" : "--png");
   if (!args.heatmap.empty()) {
@@ -355,6 +364,9 @@ int run_render(const RenderArgs& args) {
   progress.finish();
 
   RgbImage img = film.mean();
+  if (scene.film.image_scale != 1.0f) // (pbrt's Film scale and iso) FLT_MAX stays finite below
+    for (float& v : img.rgb)
+      v = std::clamp(v * scene.film.image_scale, -FLT_MAX, FLT_MAX);
   if (uint64_t n = renderer.stats().overflowed_pixels)
     std::fprintf(stderr,
                  "canopy: warning: %llu pixels exceed the float range of the image (3.4e38) and "

@@ -998,11 +998,34 @@ void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& d
       };
       res("xresolution", scene_.film.width);
       res("yresolution", scene_.film.height);
-      if (auto f = p.get_string("filename"))
-        warn(p.find("filename")->loc,
-             fmt::format("{}: \"string filename\" \"{}\": the output is --out (default "
-                         "out/<scene>.exr), ignored",
-                         p.what(), printable(*f)));
+      // pbrt-v4 (FilmBaseParameters) writes `filename` as given, relative to the working
+      // directory; here it is the default of --out. Canopy writes EXR and PNG: another extension
+      // is replaced by .exr, with a warning.
+      if (auto f = p.get_string("filename")) {
+        std::filesystem::path out(*f);
+        std::string ext = out.extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(),
+                       [](unsigned char c) { return char(std::tolower(c)); });
+        if (f->empty() || out.filename().empty())
+          fail(p.find("filename")->loc, fmt::format("{}: \"string filename\": empty", p.what()));
+        if (ext != ".exr" && ext != ".png") {
+          warn(p.find("filename")->loc,
+               fmt::format("{}: \"string filename\" \"{}\": Canopy writes EXR and PNG, written "
+                           "as .exr",
+                           p.what(), printable(*f)));
+          out.replace_extension(".exr");
+        }
+        scene_.film.output = out.string();
+      }
+      // The image scale: pbrt-v4's RGBFilm multiplies by its sensor's imaging ratio, ISO / 100
+      // for the default sensor (and the shutter time, 1 by default); pbrt-v3's "scale" multiplies
+      // too. Both are read, as one factor.
+      double scale = p.get_float("scale", 1.0) * p.get_float("iso", 100.0) / 100.0;
+      if (!(scale > 0.0 && scale <= 1e30))
+        fail(d.loc, fmt::format("{}: the image scale (scale x iso / 100 = {}) must be in "
+                                "(0, 1e30]",
+                                p.what(), scale));
+      scene_.film.image_scale = float(scale);
       p.finish();
     } else if (k == "Sampler") {
       need_world(false);

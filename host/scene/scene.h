@@ -76,6 +76,11 @@ struct Camera {
 struct FilmSettings {
   int width = 640;  // pixels, 1 .. kMaxFilmSide
   int height = 480; // pixels, 1 .. kMaxFilmSide
+  // The scene's own output image (pbrt's Film "filename"), the default of `canopy render --out`;
+  // empty: out/<scene>.exr.
+  std::string output;
+  // Every pixel is multiplied by this before it is written (pbrt's Film "scale" x iso / 100).
+  float image_scale = 1.0f;
 };
 
 // Defaults show the renderer at its best: the estimator with the best worst case over the
