@@ -88,6 +88,9 @@ struct Transform {
            m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
   }
   bool flips() const { return det() < 0.0; }
+  // The cofactor matrix of m, C = det(m) m^-T, and det(m) from the first row of C (for normals
+  // and for the inverse).
+  double cofactors(double c[3][3]) const;
   // The transformed direction of a surface normal n: the inverse transpose of m applied to n,
   // up to a positive factor (the cofactor matrix, sign-corrected by det), unit length; (0,0,0)
   // if n is zero or not finite, or the result cannot be normalised. In double, so a tiny or huge

@@ -582,14 +582,8 @@ void Params::finish() {
 // ----------------------------------------------------------------------------- transforms
 
 Transform inverse(const Transform& x, bool& ok) {
-  const auto& a = x.m;
   double c[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-      c[i][j] = a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1];
-    }
-  double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+  double det = x.cofactors(c); // m^-1 = C^T / det
   Transform r;
   ok = det != 0.0 && std::isfinite(det);
   if (!ok) return r;

@@ -24,17 +24,21 @@ Transform Transform::then(const Transform& outer) const {
   return r;
 }
 
-float3 Transform::apply_normal(float3 n) const {
+double Transform::cofactors(double c[3][3]) const {
   const auto& a = m;
-  // Cofactor matrix C = det(M) M^-T: normals transform by M^-T; C avoids the division, and the
-  // sign of det keeps the direction (a mirror must not turn the normal inside out).
-  double c[3][3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       int i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
       c[i][j] = a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1];
     }
-  double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+  return a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+}
+
+float3 Transform::apply_normal(float3 n) const {
+  // Normals transform by M^-T; the cofactor matrix C = det(M) M^-T avoids the division, and the
+  // sign of det keeps the direction (a mirror must not turn the normal inside out).
+  double c[3][3];
+  double det = cofactors(c);
   double s = det < 0.0 ? -1.0 : 1.0;
   double x = double(n.x), y = double(n.y), z = double(n.z);
   double r[3];
