@@ -14,17 +14,26 @@
 #define LIGHT_TRIANGLE 4 // triangle area light: radiance L (also every emissive mesh triangle)
 #define LIGHT_DISK 5     // disk area light: radiance L, one- or two-sided
 #define LIGHT_TYPE_COUNT 6
+// A distant light (the sun): parallel light from direction e1 (unit, towards the light) with
+// irradiance E on a surface facing it. Not in the light tree nor in the power and uniform
+// samplers: the device light buffer holds the scene's distant lights after its light_count others,
+// and every shading point samples each of them (cl/integrator/light_pick.h, "distant lights").
+#define LIGHT_DISTANT 6
+// Distant lights per scene at most: each shading point stages one shadow item per distant light
+// beside its own pick in the LIGHT_PICK_SHADOW_SLOTS (4) of its root item.
+#define MAX_DISTANT_LIGHTS 3
 
 #define LIGHT_FLAG_TWO_SIDED 1 // quad/triangle/disk emit on both faces
 #define LIGHT_FLAG_FROM_MESH 2 // triangle is part of a mesh already in the geometry
 
 typedef struct Light {
   // point/spot/sphere: position (xyz), sphere radius (w). quad: corner. triangle: v0. disk: centre
-  // (xyz), radius (w).
+  // (xyz), radius (w). distant: unused.
   float4 p;
   // quad: edge 1; triangle: v1 - v0; spot: unit axis (xyz), cos of the cone half-angle rounded
   // down (w; a bound that only ever widens the cone, for the light tree). disk: unit tangent t1
-  // (xyz) of the orthonormal frame (t1, t2, n), w unused.
+  // (xyz) of the orthonormal frame (t1, t2, n), w unused. distant: unit direction towards the
+  // light (xyz).
   float4 e1;
   // quad: edge 2; triangle: v2 - v0; spot: 1 - cos of the cone half-angle (x) and of the
   // falloff-start half-angle (y), both from 2 sin^2(angle / 2) in double (the falloff works in
@@ -32,7 +41,7 @@ typedef struct Light {
   // tangent t2 = n x t1 (xyz), w unused.
   float4 e2;
   float4 n;        // quad/triangle/disk: unit normal of the emitting face (xyz), area (w)
-  float4 emission; // rgb: intensity (point/spot) or radiance (area lights)
+  float4 emission; // rgb: intensity (point/spot), radiance (area lights) or irradiance (distant)
   int type;
   int flags;
   int prim; // first geometry primitive that shows this light (-1 for point/spot)

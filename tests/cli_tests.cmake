@@ -195,11 +195,11 @@ canopy_cli_test(cli_pbrt_render_small
 # A construct the reader skips: a one-line warning naming file:line, and the render goes on.
 canopy_cli_test(cli_pbrt_warning
   "-DARGS=render|${CANOPY_PBRT_DATA}/warn.pbrt|--spp|1|--quiet|--out|${CANOPY_SCRATCH}/pbrt_warn.exr"
-  "-DSTDERR=canopy: warning: ${CANOPY_PBRT_DATA}/warn.pbrt:6: LightSource \"distant\" is not read in this slice, ignored"
+  "-DSTDERR=canopy: warning: ${CANOPY_PBRT_DATA}/warn.pbrt:6: LightSource \"goniometric\" is not read in this slice, ignored"
   -P ${CANOPY_CHECK_CLI})
 # --strict: the same warning is an error, exit 2, one line.
 canopy_cli_test(cli_pbrt_strict -DSCENE=${CANOPY_PBRT_DATA}/warn.pbrt "-DARGS=--strict"
-  "-DEXPECT=${CANOPY_PBRT_DATA}/warn.pbrt:6: LightSource \"distant\" is not read in this slice, ignored (--strict: warnings are errors)"
+  "-DEXPECT=${CANOPY_PBRT_DATA}/warn.pbrt:6: LightSource \"goniometric\" is not read in this slice, ignored (--strict: warnings are errors)"
   -P ${CANOPY_CHECK2})
 # The Film's filename is the default output (relative to the working directory, as pbrt writes it).
 canopy_cli_test(cli_pbrt_film_output

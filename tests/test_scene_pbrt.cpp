@@ -437,7 +437,7 @@ TEST(ScenePbrt, EveryUnknownDirectiveOrParameterWarningNamesFileAndLine) {
                  "Option \"bool wavefront\" true\n"
                  "WorldBegin\n"
                  "Shape \"plymesh\" \"string filename\" \"a.ply\"\n"
-                 "LightSource \"distant\"\n"
+                 "LightSource \"goniometric\"\n"
                  "LightSource \"infinite\"\n"
                  "Shape \"sphere\" \"float radius\" 1 \"float wobble\" 2\n");
   const char* want[] = {"t.pbrt:1: unknown directive 'Frobnicate' ignored",
@@ -445,7 +445,7 @@ TEST(ScenePbrt, EveryUnknownDirectiveOrParameterWarningNamesFileAndLine) {
                         "pinhole (no thin lens), ignored",
                         "t.pbrt:3: Option",
                         "t.pbrt:5: Shape \"plymesh\" is not read in this slice",
-                        "t.pbrt:6: LightSource \"distant\" is not read",
+                        "t.pbrt:6: LightSource \"goniometric\" is not read",
                         "t.pbrt:7: LightSource \"infinite\" is not read",
                         "t.pbrt:8: Shape \"sphere\": unknown parameter \"float wobble\" ignored"};
   ASSERT_EQ(s.warnings.size(), std::size(want));
@@ -456,10 +456,10 @@ TEST(ScenePbrt, EveryUnknownDirectiveOrParameterWarningNamesFileAndLine) {
 }
 
 TEST(ScenePbrt, StrictTurnsAWarningIntoAnError) {
-  const std::string text = "WorldBegin\nShape \"sphere\"\nLightSource \"distant\"\n";
+  const std::string text = "WorldBegin\nShape \"sphere\"\nLightSource \"goniometric\"\n";
   EXPECT_EQ(error_of(text), "");
   std::string e = error_of(text, true);
-  EXPECT_EQ(e.rfind("t.pbrt:3: LightSource \"distant\" is not read in this slice, ignored", 0), 0u)
+  EXPECT_EQ(e.rfind("t.pbrt:3: LightSource \"goniometric\" is not read in this slice, ignored", 0), 0u)
       << e;
   EXPECT_EQ(e.find('\n'), std::string::npos);
 }

@@ -29,7 +29,9 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   float f_w = pb->shade_f[path].w;
   float w = 1.0f;
   float p_L = pmf * lp.s.pdf;
-  if (HAS_MICROFACET && light_sampler_brdf(ls) && f_w == BRDF_POINT_FLAG) {
+  if (HAS_LIGHT_DISTANT && light >= ls->light_count) {
+    // A distant light: no other technique finds it (a delta direction, outside the tree).
+  } else if (HAS_MICROFACET && light_sampler_brdf(ls) && f_w == BRDF_POINT_FLAG) {
     // A glossy point: against its N BRDF-aware samples (brdf_mis.h).
     w = brdf_weight_tree(ls, p_L, brdf_light_pmf_weight(ls, pb, path, light) * lp.s.pdf,
                          lp.bsdf_pdf, pb->brdf_state[path].y, pb->brdf_share[path]);
@@ -58,9 +60,26 @@ INLINE int light_pick_items(const LightSamplerCtx* ls, const SceneBuffers* sc,
   return light_pick_shadow_item(ls, sc, pb, path, light, pmf, rng, out);
 }
 
+// Distant lights (cl/types.h LIGHT_DISTANT) are sampled beside the light sampler: the root item of
+// every shading point takes each of them with probability 1 (a shadow ray per distant light and
+// point). They have no position, so the tree has no place for them; pbrt-v4 instead picks among
+// its n infinite lights and the tree with probability n / (n + 1) and 1 / (n + 1). The choice was
+// measured (docs/performance.md, "Distant lights"). At most MAX_DISTANT_LIGHTS, so that they and
+// the root's own pick fit its LIGHT_PICK_SHADOW_SLOTS.
+INLINE int light_pick_distant(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                              const PathBuffers* pb, int path, uint seed, GLOBAL ShadowItem* out) {
+  int n = 0;
+  for (int j = 0; j < ls->distant_count; ++j) {
+    LtRng rng = lt_rng_make(seed, 0x40000000u ^ (uint)j); // apart from codes and leaf lights
+    n += light_pick_shadow_item(ls, sc, pb, path, ls->light_count + j, 1.0f, &rng, &out[n]);
+  }
+  return n;
+}
+
 // Processes one split item: a cluster for a path's shading point or (SPLIT_SEGMENT) for its
 // medium segment. Stages up to 4 child items in children[0..3] or up to LIGHT_PICK_SHADOW_SLOTS
-// shadow items in shadows[]. Returns (children staged, shadow items staged, lights in the cut, 0).
+// shadow items in shadows[] (a shading point's root item: its distant lights first, then its own
+// pick). Returns (children staged, shadow items staged, lights in the cut, 0).
 INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const SceneBuffers* sc,
                             const PathBuffers* pb, GLOBAL SplitItem* children,
                             GLOBAL ShadowItem* shadows) {
@@ -77,6 +96,16 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
     seed = float_as_uint_(pb->shade_N[path].w);
   }
   const LtTree* t = &ls->tree;
+  if (HAS_LIGHT_DISTANT && !segment && it.code == 0 && ls->distant_count > 0) {
+    out.y = light_pick_distant(ls, sc, pb, path, seed, shadows);
+    out.z = ls->distant_count;
+    // No other light (the tree is empty), or a glossy point of brdf-oriented, whose BRDF-oriented
+    // samples (brdf_mis.h) are its only light samples of the others.
+    int brdf_only = HAS_MICROFACET ? ls->kind == SAMPLER_BRDF_ORIENTED &&
+                                         pb->shade_f[path].w == BRDF_POINT_FLAG
+                                   : 0;
+    if (ls->light_count <= 0 || brdf_only) return out;
+  }
 
   if (light_sampler_splits(ls) &&
       lt_item_splits_q(t, it.sphere, it.cv2, it.code, it.budget, &q, ls->threshold)) {
@@ -113,9 +142,9 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
   LtRng rng = lt_rng_make(seed, (uint)it.code);
   float pmf;
   int light = light_sampler_pick_q(ls, it.code, &q, &rng, &pmf);
-  out.z = 1;
+  out.z += 1;
   if (light >= 0)
-    out.y = light_pick_items(ls, sc, pb, path, segment, light, pmf, &rng, &shadows[0]);
+    out.y += light_pick_items(ls, sc, pb, path, segment, light, pmf, &rng, &shadows[out.y]);
   return out;
 }
 

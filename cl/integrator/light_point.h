@@ -48,6 +48,12 @@ INLINE int light_point_sample(const LightSamplerCtx* ls, const SceneBuffers* sc,
     lp->bsdf_pdf = bsdf_pdf(&m, wo, wi);
   }
   if (s.is_delta) lp->bsdf_pdf = 0.0f; // BSDF sampling never finds a point light
+  if (HAS_LIGHT_DISTANT && s.dist == FLT_INF) { // a distant light: an unbounded shadow ray
+    lp->origin = f4_from3(P, FLT_INF);
+    lp->dir = f4_from3(s.wi, uint_as_float_((uint)path));
+    lp->s = s;
+    return 1;
+  }
   float3 to = s.x - P;
   float dist = length(to);
   if (!(dist > 0.0f)) return 0;

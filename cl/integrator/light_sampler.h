@@ -29,6 +29,9 @@ typedef struct LightSamplerCtx {
   float brdf_lambda;
   int brdf_nmax;
   int brdf_adaptive;
+  // Distant lights: lights[light_count .. light_count + distant_count), outside every technique
+  // above; each shading point samples all of them (light_pick.h).
+  int distant_count;
 } LightSamplerCtx;
 
 // Cut budget of a medium segment's root (Conty Estevez & Kulla 2018, §5.4, last paragraph: the

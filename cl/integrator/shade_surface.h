@@ -95,15 +95,17 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   int last = depth + 1 >= max_depth; // the BSDF ray only looks for emission (see the top)
   // Light shapes are black diffuse: nothing to pick lights for.
   int black = m.type == MATERIAL_DIFFUSE && !(max3(xyz_of(m.albedo)) > 0.0f);
-  out.y = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && bsdf_has_smooth_lobe(&m) && !black;
+  out.y = (ls->light_count > 0 || ls->distant_count > 0) && ls->kind != SAMPLER_BSDF &&
+          bsdf_has_smooth_lobe(&m) && !black;
   float mis_flag = CANOPY_MIS ? 1.0f : 0.0f;
   if (HAS_MICROFACET && light_sampler_brdf(ls)) {
     // Glossy points get BRDF-oriented sampling (brdf_mis.h: -1 asks brdf_cut for the cut);
     // brdf-oriented alone takes no tree light sample there.
-    int glossy = out.y && brdf_material_glossy(&m);
+    int glossy = out.y && ls->light_count > 0 && brdf_material_glossy(&m);
     pb->brdf_state[path] = make_int4(0, glossy ? -1 : 0, 0, 0);
     if (glossy) mis_flag = BRDF_POINT_FLAG;
-    if (glossy && ls->kind == SAMPLER_BRDF_ORIENTED) out.y = 0;
+    // (distant lights are still sampled there: light_pick.h)
+    if (glossy && ls->kind == SAMPLER_BRDF_ORIENTED) out.y = ls->distant_count > 0;
   }
   pb->shade_N[path] = f4_from3(N, uint_as_float_(light_seed));
   pb->shade_f[path] = f4_from3(beta, mis_flag);

@@ -39,7 +39,7 @@
       __global const float4 *lt_nodes, __global const int4 *lt_children,                           \
       __global const int *lt_leaf_lights, __global const uint *lt_trails, float4 lt_root_sphere,   \
       float4 lt_root_info, float split_threshold, uint max_cut, __global float2 *brdf_cut,         \
-      float brdf_delta, float brdf_lambda, int brdf_nmax, int brdf_adaptive,
+      float brdf_delta, float brdf_lambda, int brdf_nmax, int brdf_adaptive, int distant_count,
 
 #define LIGHT_SAMPLER_ASSEMBLE(ls)                                                                 \
   LightSamplerCtx ls;                                                                              \
@@ -62,7 +62,8 @@
   ls.brdf_delta = brdf_delta;                                                                      \
   ls.brdf_lambda = brdf_lambda;                                                                    \
   ls.brdf_nmax = brdf_nmax;                                                                        \
-  ls.brdf_adaptive = brdf_adaptive
+  ls.brdf_adaptive = brdf_adaptive;                                                                \
+  ls.distant_count = HAS_LIGHT_DISTANT ? distant_count : 0
 
 // An exclusive scan's input (counts) and result (block_sums[i / block] + offsets[i]).
 #define SCAN_PARAMS                                                                                \

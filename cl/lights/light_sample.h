@@ -16,8 +16,9 @@ typedef struct LightSample {
   float dist;   // distance to the light point
   float3 Li;    // radiance arriving along wi (delta lights: intensity / dist^2)
   float pdf;    // solid-angle pdf of wi (1 for delta lights); 0 means "no contribution"
-  int is_delta; // point and spot lights
-  // Where a shadow ray towards the sample ends: the light point itself for point and spot lights;
+  int is_delta; // point, spot and distant lights
+  // Where a shadow ray towards the sample ends: the light point itself for point and spot lights
+  // (a distant light's ray has no end: dist is infinite and x is P);
   // for area lights the sampled point moved off the light's surface towards P by its own float
   // error bound, so the light's own primitive cannot occlude it (cl/shading.h).
   float3 x;
@@ -99,6 +100,15 @@ INLINE LightSample sample_light(const GLOBAL Light* l, float3 P, float u1, float
   s.is_delta = 0;
   s.x = P;
   float3 L = xyz_of(l->emission);
+  if (IS_LIGHT(l, LIGHT_DISTANT)) {
+    // Parallel light: the same direction and irradiance everywhere; the shadow ray is unbounded.
+    s.wi = xyz_of(l->e1);
+    s.dist = FLT_INF;
+    s.Li = L;
+    s.pdf = 1.0f;
+    s.is_delta = 1;
+    return s;
+  }
   if (IS_LIGHT(l, LIGHT_POINT) || IS_LIGHT(l, LIGHT_SPOT)) {
     s.x = xyz_of(l->p);
     float3 to = s.x - P;

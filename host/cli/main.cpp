@@ -332,7 +332,7 @@ int run_render(const RenderArgs& args) {
   if (!args.stats_json.empty()) check_writable(args.stats_json, "--stats-json");
 
   const std::string scene_name = printable(args.scene, 1024);
-  if (scene.lights.empty())
+  if (scene.lights.empty() && scene.distant_lights.empty())
     std::fprintf(
         stderr, "canopy: warning: %s: the scene has no emitters%s; the image is black\n",
         scene_name.c_str(),
@@ -400,9 +400,11 @@ int run_render(const RenderArgs& args) {
   if (!args.emitter_mask.empty())
     write_png(args.emitter_mask, mask_to_image(film.emitter_mask(), film.width, film.height));
   const RenderStats& st = renderer.stats();
-  std::string skipped = scene.skipped_lights
-                            ? fmt::format(" ({} with zero emission skipped)", scene.skipped_lights)
-                            : std::string();
+  std::string skipped =
+      (scene.distant_lights.empty() ? std::string()
+                                    : fmt::format(" and {} distant", scene.distant_lights.size())) +
+      (scene.skipped_lights ? fmt::format(" ({} with zero emission skipped)", scene.skipped_lights)
+                            : std::string());
   std::string part_text;
   if (args.samples)
     part_text += fmt::format(" (samples {}:{})", part.sample_begin, part.sample_end);
@@ -436,6 +438,7 @@ int run_render(const RenderArgs& args) {
     j["spp"] = scene.integrator.spp;
     j["film"] = {scene.film.width, scene.film.height};
     j["lights"] = scene.lights.size();
+    j["distant_lights"] = scene.distant_lights.size();
     j["device"] = rt.device_name();
     std::ofstream out(args.stats_json);
     if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.stats_json));

@@ -6,18 +6,26 @@ namespace canopy {
 
 namespace {
 
-// The lights with emission times 2^-k, uploaded in chunks (no second host copy of a light set of
-// 10^7 lights). Emission is read on the device only as radiance/intensity (sample_light,
-// light_emitted_radiance); pmfs and MIS weights use the sampler's own buffers.
-cl::Buffer upload_scaled_lights(const cl::Context& ctx, const std::vector<Light>& lights, int k) {
-  if (k == 0 || lights.empty()) return upload_buffer(ctx, lights);
-  cl::Buffer buf(ctx, CL_MEM_READ_ONLY, lights.size() * sizeof(Light));
+// The lights, then the distant lights, with emission times 2^-k, uploaded in chunks (no second
+// host copy of a light set of 10^7 lights). Emission is read on the device only as
+// radiance/intensity (sample_light, light_emitted_radiance); pmfs and MIS weights use the
+// sampler's own buffers.
+cl::Buffer upload_scaled_lights(const cl::Context& ctx, const std::vector<Light>& lights,
+                                const std::vector<Light>& distant, int k) {
+  if ((k == 0 && distant.empty()) || (lights.empty() && distant.empty()))
+    return upload_buffer(ctx, lights);
+  const size_t total = lights.size() + distant.size();
+  cl::Buffer buf(ctx, CL_MEM_READ_ONLY, total * sizeof(Light));
   cl::CommandQueue q(ctx, ctx.getInfo<CL_CONTEXT_DEVICES>().at(0));
   const size_t chunk = size_t(1) << 16;
   std::vector<Light> part;
-  for (size_t first = 0; first < lights.size(); first += chunk) {
-    size_t n = std::min(chunk, lights.size() - first);
-    part.assign(lights.begin() + std::ptrdiff_t(first), lights.begin() + std::ptrdiff_t(first + n));
+  for (size_t first = 0; first < total; first += chunk) {
+    size_t n = std::min(chunk, total - first);
+    part.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      size_t j = first + i;
+      part[i] = j < lights.size() ? lights[j] : distant[j - lights.size()];
+    }
     for (Light& l : part) {
       l.emission.x = std::ldexp(l.emission.x, -k);
       l.emission.y = std::ldexp(l.emission.y, -k);
@@ -33,7 +41,8 @@ cl::Buffer upload_scaled_lights(const cl::Context& ctx, const std::vector<Light>
 DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geometry,
                                 const std::vector<Material>& materials,
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
-                                int emission_exponent, const Medium& medium) {
+                                int emission_exponent, const Medium& medium,
+                                const std::vector<Light>& distant_lights) {
   DeviceScene d;
   d.nodes = upload_buffer(ctx, geometry.bvh.nodes);
   d.leaf_blocks = upload_buffer(ctx, geometry.bvh.leaf_blocks);
@@ -41,13 +50,15 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
   d.materials = upload_buffer(ctx, materials);
   d.shading_normals = upload_buffer(ctx, geometry.shading_normals); // one element when empty
   d.medium = upload_buffer(ctx, std::vector<Medium>{medium});
-  upload_light_sampler(ctx, lights, sampler, emission_exponent, d);
+  upload_light_sampler(ctx, lights, sampler, emission_exponent, d, distant_lights);
   return d;
 }
 
 void upload_light_sampler(const cl::Context& ctx, const std::vector<Light>& lights,
-                          const LightSamplerData& sampler, int emission_exponent, DeviceScene& d) {
-  d.lights = upload_scaled_lights(ctx, lights, emission_exponent);
+                          const LightSamplerData& sampler, int emission_exponent, DeviceScene& d,
+                          const std::vector<Light>& distant_lights) {
+  d.lights = upload_scaled_lights(ctx, lights, distant_lights, emission_exponent);
+  d.distant_count = int(distant_lights.size());
   d.power_pmf = upload_buffer(ctx, sampler.power_pmf);
   d.alias_prob = upload_buffer(ctx, sampler.alias_prob);
   d.alias_index = upload_buffer(ctx, sampler.alias_index);
@@ -68,6 +79,7 @@ void DeviceScene::set_args(KernelArgs& args) const {
   SCENE_BUFFERS(CANOPY_SET_SCENE_ARG)
 #undef CANOPY_SET_SCENE_ARG
   args.set("light_count", cl_int(light_count));
+  args.set("distant_count", cl_int(distant_count));
   args.set("lights", lights);
   args.set("power_pmf", power_pmf);
   args.set("alias_prob", alias_prob);

@@ -31,6 +31,7 @@ struct DeviceScene {
   cl::Buffer lights;
   cl::Buffer power_pmf, alias_prob, alias_index, lt_nodes, lt_children, lt_leaf_lights, lt_trails;
   int light_count = 0;
+  int distant_count = 0; // distant lights, after the light_count others in `lights`
   float4 root_sphere{0, 0, 0, 0}, root_info{0, 0, 0, 0};
   float split_threshold = 0.0f;
   uint32_t max_cut = 1;
@@ -49,11 +50,13 @@ struct DeviceScene {
 DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geometry,
                                 const std::vector<Material>& materials,
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
-                                int emission_exponent = 0, const Medium& medium = {});
+                                int emission_exponent = 0, const Medium& medium = {},
+                                const std::vector<Light>& distant_lights = {});
 
 // Uploads only the lights and the light sampler's buffers into `d` (the part of
 // upload_device_scene that the pick tests and benchmarks need without any geometry).
 void upload_light_sampler(const cl::Context& ctx, const std::vector<Light>& lights,
-                          const LightSamplerData& sampler, int emission_exponent, DeviceScene& d);
+                          const LightSamplerData& sampler, int emission_exponent, DeviceScene& d,
+                          const std::vector<Light>& distant_lights = {});
 
 } // namespace canopy

@@ -142,9 +142,14 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
 
   t0 = Clock::now();
   const cl::Context& ctx = rt.context();
-  stats_.emission_exponent = emission_scale_exponent(scene.lights);
+  // The exponent of the brightest emission of either list (0 for an empty list: not a candidate).
+  stats_.emission_exponent = scene.distant_lights.empty() ? emission_scale_exponent(scene.lights)
+                             : scene.lights.empty()
+                                 ? emission_scale_exponent(scene.distant_lights)
+                                 : std::max(emission_scale_exponent(scene.lights),
+                                            emission_scale_exponent(scene.distant_lights));
   device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
-                                stats_.emission_exponent, scene.medium);
+                                stats_.emission_exponent, scene.medium, scene.distant_lights);
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
   camera_ = upload_buffer(ctx, cam);
@@ -194,7 +199,9 @@ Film Renderer::render(const RenderSettings& settings) {
   const size_t shadow_slots = LIGHT_PICK_SHADOW_SLOTS;
   const size_t segment_items =
       std::min<size_t>(sampler_.max_cut, light_sampler_segment_budget(sampler_.root_budget()));
-  const size_t cut_items = size_t(sampler_.max_cut) + (medium ? segment_items : 0u);
+  // A shading point's distant lights (light_pick.h) come on top of its cut.
+  const size_t cut_items =
+      size_t(sampler_.max_cut) + (medium ? segment_items : 0u) + scene_.distant_lights.size();
   size_t wave =
       std::max<size_t>(1, std::min(settings.wave_size, options_.split_queue_items / cut_items));
   const size_t W = size_t(std::min<uint64_t>(total, wave));

@@ -71,7 +71,8 @@ float3 position(const JsonObject& o, std::string_view key, bool is_template, flo
 
 Light parse_light(const JsonValue& v, bool is_template, double3 origin) {
   auto o = v.as_object();
-  std::string type = o.req("type").as_enum({"point", "spot", "sphere", "quad", "triangle", "disk"});
+  std::string type =
+      o.req("type").as_enum({"point", "spot", "sphere", "quad", "triangle", "disk", "distant"});
   Light l{};
   l.prim = -1;
   const float3 zero = make_float3(0, 0, 0);
@@ -98,6 +99,17 @@ Light parse_light(const JsonValue& v, bool is_template, double3 origin) {
     }
     set_spot_cone(l, double(cone), double(start));
     l.emission = f4_from3(o.req("intensity").as_emission(), 0.0f);
+  } else if (type == "distant") {
+    // Parallel light travelling along `direction` (as pbrt-v4's from -> to), with `irradiance` on
+    // a surface facing it. It has no position: as a light set template it would mean nothing.
+    if (is_template) o.req("type").fail("a distant light cannot be a light set template");
+    o.allow({"type", "direction", "irradiance"});
+    l.type = LIGHT_DISTANT;
+    float3 dir = normalize(o.req("direction").as_vec3_nonzero());
+    if (!std::isfinite(dir.x) || !std::isfinite(dir.y) || !std::isfinite(dir.z))
+      o.req("direction").fail("cannot be normalised");
+    l.e1 = f4_from3(dir * -1.0f, 0.0f);
+    l.emission = f4_from3(o.req("irradiance").as_emission(), 0.0f);
   } else if (type == "sphere") {
     o.allow({"type", "center", "radius", "radiance"});
     l.type = LIGHT_SPHERE;

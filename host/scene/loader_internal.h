@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <string>
@@ -186,6 +187,10 @@ void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,
                     std::string_view what);
 // True if the light has a non-zero emission.
 bool emits(const Light& l);
+// Adds a distant light (LIGHT_DISTANT) to scene.distant_lights, or calls fail (which throws) with
+// the reason it cannot be rendered: a medium in the scene, or more than MAX_DISTANT_LIGHTS.
+void add_distant_light(Scene& scene, const Light& l,
+                       const std::function<void(const std::string&)>& fail);
 
 // Lights (lights.cpp).
 // An analytic light from a JSON object, its positions rebased to `origin` (the scene origin). As a

@@ -1358,7 +1358,7 @@ void Reader::shape(const Token& d, Params& p, const std::string& type) {
 
 // The format page, "Lights".
 void Reader::light_source(const Token& d, Params& p, const std::string& type) {
-  if (type != "point" && type != "spot") {
+  if (type != "point" && type != "spot" && type != "distant") {
     warn(d.loc,
          fmt::format("LightSource \"{}\" is not read in this slice, ignored", printable(type)));
     return;
@@ -1375,9 +1375,16 @@ void Reader::light_source(const Token& d, Params& p, const std::string& type) {
     p.finish();
     return;
   }
-  float3 I = p.spectrum("I", Params::Use::Illuminant).value_or(make_float3(1, 1, 1));
+  const bool distant = type == "distant";
+  float3 I =
+      p.spectrum(distant ? "L" : "I", Params::Use::Illuminant).value_or(make_float3(1, 1, 1));
   double scale = p.get_float("scale", 1.0);
   if (!(scale >= 0.0)) fail(d.loc, fmt::format("{}: \"float scale\": must be >= 0", p.what()));
+  // pbrt-v4 DistantLight: "illuminance" E_v > 0 multiplies the 1-nit normalised L (lights.cpp).
+  if (distant) {
+    double ev = p.get_float("illuminance", -1.0);
+    if (ev > 0.0) scale *= ev;
+  }
   float3 em = to_float3(dvec(I) * scale);
   if (!std::isfinite(em.x + em.y + em.z))
     fail(d.loc, fmt::format("{}: I * scale is too large", p.what()));
@@ -1389,6 +1396,16 @@ void Reader::light_source(const Token& d, Params& p, const std::string& type) {
   l.p = f4_from3(rebase(xf.apply(from), scene_.origin), 0.0f);
   if (type == "point") {
     l.type = LIGHT_POINT;
+  } else if (distant) {
+    // Light travels from "from" to "to" (pbrt-v4 DistantLight): e1 points back, towards it.
+    l.type = LIGHT_DISTANT;
+    l.p = make_float4(0, 0, 0, 0);
+    double3 to = p.get_point("to").value_or(double3{0, 0, 1});
+    double3 dir = linear(xf, from - to);
+    double dl = len3(dir);
+    if (!(dl > 0.0) || !std::isfinite(dl))
+      fail(d.loc, fmt::format("{}: \"from\" and \"to\" must differ", p.what()));
+    l.e1 = f4_from3(to_float3(dir * (1.0 / dl)), 0.0f);
   } else {
     l.type = LIGHT_SPOT;
     double3 to = p.get_point("to").value_or(double3{0, 0, 1});
@@ -1409,10 +1426,12 @@ void Reader::light_source(const Token& d, Params& p, const std::string& type) {
   }
   p.finish();
   if (auto e = check_light_extent(l, scene_.origin); !e.empty()) fail(d.loc, e);
-  if (emits(l))
-    scene_.lights.push_back(l);
-  else
+  if (!emits(l))
     ++scene_.skipped_lights;
+  else if (distant)
+    add_distant_light(scene_, l, [&](const std::string& e) { fail(d.loc, e); });
+  else
+    scene_.lights.push_back(l);
 }
 
 void Reader::area_light(const Token& d, Params& p, const std::string& type) {

@@ -3,9 +3,9 @@
 // docs/scene-format.md.
 #pragma once
 
-#include "light_tree/split.h"              // cl/: LT_DEFAULT_SPLIT_THRESHOLD
 #include "light_tree/light_sampler_names.h" // kLightSamplerNames
-#include "types.h"                         // cl/types.h: Light, Material (device layouts)
+#include "light_tree/split.h"               // cl/: LT_DEFAULT_SPLIT_THRESHOLD
+#include "types.h"                          // cl/types.h: Light, Material (device layouts)
 
 #include <array>
 #include <cstdint>
@@ -179,6 +179,9 @@ struct Scene {
   std::vector<float3> shading_normals;
   std::vector<int32_t> triangle_normals;
   std::vector<Light> lights; // only lights that emit (zero-emission lights are skipped)
+  // Distant lights (LIGHT_DISTANT, at most MAX_DISTANT_LIGHTS): apart from `lights`, which the
+  // light samplers and the tree cover; every shading point samples each of them.
+  std::vector<Light> distant_lights;
   // A homogeneous participating medium (the scene's "medium"; cl/types.h Medium), if any.
   bool has_medium = false;
   Medium medium{};
