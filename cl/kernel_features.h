@@ -13,6 +13,7 @@
 #define HAS_LIGHT_TRIANGLE 1
 #define HAS_LIGHT_DISK 1
 #define HAS_LIGHT_DISTANT 1
+#define HAS_LIGHT_ENVIRONMENT 1
 #define HAS_PRIM_SPHERE 1
 #define HAS_PRIM_DISK 1
 #define HAS_MATERIAL_CONDUCTOR 1
@@ -32,5 +33,7 @@
 #define IS_MATERIAL(m, T) (HAS_##T ? (m)->type == T : 0)
 // GGX code (cl/bsdf/microfacet.h) is compiled only for scenes with a glossy material.
 #define HAS_MICROFACET (HAS_MATERIAL_CONDUCTOR || HAS_MATERIAL_PLASTIC)
+// Lights at infinity (cl/types.h): distant or environment lights.
+#define HAS_INFINITE_LIGHT (HAS_LIGHT_DISTANT || HAS_LIGHT_ENVIRONMENT)
 
 #endif // CANOPY_CL_FEATURES_H

@@ -14,14 +14,24 @@
 #define LIGHT_TRIANGLE 4 // triangle area light: radiance L (also every emissive mesh triangle)
 #define LIGHT_DISK 5     // disk area light: radiance L, one- or two-sided
 #define LIGHT_TYPE_COUNT 6
+// Lights at infinity: not in the light tree nor in the power and uniform samplers. The device light
+// buffer holds the scene's infinite lights after its light_count others, and every shading point
+// samples each of them once (cl/integrator/light_pick.h, "lights at infinity").
 // A distant light (the sun): parallel light from direction e1 (unit, towards the light) with
-// irradiance E on a surface facing it. Not in the light tree nor in the power and uniform
-// samplers: the device light buffer holds the scene's distant lights after its light_count others,
-// and every shading point samples each of them (cl/integrator/light_pick.h, "distant lights").
+// irradiance E (emission) on a surface facing it.
 #define LIGHT_DISTANT 6
-// Distant lights per scene at most: each shading point stages one shadow item per distant light
+// An environment light (the sky): radiance from every direction, emission times a map's texel
+// (cl/lights/environment.h; flags: ENV_CONSTANT, no map, or the map's projection), in the map
+// frame whose x, y, z axes are e1, e2, n (unit, orthonormal, world space). p.x, p.y, p.z: the bits
+// of the map's first texel in the environment buffers, its width and its height (uint).
+#define LIGHT_ENVIRONMENT 7
+// Light::flags of an environment light: its map's projection (map frame e1, e2, n = x, y, z).
+#define ENV_CONSTANT 0   // no map: radiance = emission
+#define ENV_EQUIRECT 1   // u = phi / 2 pi from +x towards +y, v = theta / pi from +z (row 0 at +z)
+#define ENV_OCTAHEDRAL 2 // pbrt-v4's EqualAreaSquareToSphere, z up; square maps only
+// Infinite lights per scene at most: each shading point stages one shadow item per infinite light
 // beside its own pick in the LIGHT_PICK_SHADOW_SLOTS (4) of its root item.
-#define MAX_DISTANT_LIGHTS 3
+#define MAX_INFINITE_LIGHTS 3
 
 #define LIGHT_FLAG_TWO_SIDED 1 // quad/triangle/disk emit on both faces
 #define LIGHT_FLAG_FROM_MESH 2 // triangle is part of a mesh already in the geometry
@@ -41,7 +51,9 @@ typedef struct Light {
   // tangent t2 = n x t1 (xyz), w unused.
   float4 e2;
   float4 n;        // quad/triangle/disk: unit normal of the emitting face (xyz), area (w)
-  float4 emission; // rgb: intensity (point/spot), radiance (area lights) or irradiance (distant)
+  // rgb: intensity (point/spot), radiance (area lights), irradiance (distant), radiance scale
+  // (environment)
+  float4 emission;
   int type;
   int flags;
   int prim; // first geometry primitive that shows this light (-1 for point/spot)

@@ -80,7 +80,7 @@ TEST(DistantLight, DiffusePlaneIsExactForEverySampler) {
   for (const char* sampler : kSamplers)
     for (int depth : {1, 2}) {
       Scene scene = plane_scene(diffuse_material("white", rho), 40.0f);
-      scene.distant_lights.push_back(distant_light(travel, E));
+      scene.infinite_lights.push_back(distant_light(travel, E));
       Film film = render(scene, sampler, 4, depth);
       const float3 expect = rho * E * (cos_t / kPi);
       for (size_t p = 0; p < film.sum.size(); ++p) {
@@ -92,7 +92,7 @@ TEST(DistantLight, DiffusePlaneIsExactForEverySampler) {
       }
     }
   Scene scene = plane_scene(diffuse_material("white", rho), 40.0f);
-  scene.distant_lights.push_back(distant_light(travel, E));
+  scene.infinite_lights.push_back(distant_light(travel, E));
   Film film = render(scene, "bsdf", 4);
   for (const double4& s : film.sum)
     EXPECT_EQ(s.x + s.y + s.z, 0.0);
@@ -108,9 +108,9 @@ TEST(DistantLight, SumsWithTheTreeLightsExactly) {
   const float3 I = make_float3(4.0f, 4.0f, 4.0f), pl = make_float3(0.2f, 0.1f, 1.5f);
   for (const char* sampler : kSamplers) {
     Scene scene = plane_scene(diffuse_material("grey", rho), 1.0f); // narrow: x barely varies
-    scene.distant_lights.push_back(distant_light(t1, E1));
-    scene.distant_lights.push_back(distant_light(t2, E2));
-    scene.distant_lights.push_back(distant_light(make_float3(0, 0, 1), E2 * 100.0f)); // below
+    scene.infinite_lights.push_back(distant_light(t1, E1));
+    scene.infinite_lights.push_back(distant_light(t2, E2));
+    scene.infinite_lights.push_back(distant_light(make_float3(0, 0, 1), E2 * 100.0f)); // below
     Light point{};
     point.type = LIGHT_POINT;
     point.p = f4_from3(pl, 0.0f);
@@ -152,7 +152,7 @@ TEST(DistantLight, GlossyPlaneMatchesTheBrdfForEverySampler) {
                                          make_float3(3.983f, 2.385f, 1.603f));
   for (const char* sampler : kSamplers) {
     Scene scene = plane_scene(gold, 20.0f);
-    scene.distant_lights.push_back(distant_light(travel, E));
+    scene.infinite_lights.push_back(distant_light(travel, E));
     Film film = render(scene, sampler, 64);
     CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
     const Material m = scene.materials[0].gpu;
@@ -206,7 +206,7 @@ TEST(DistantLight, CastsAShadow) {
   scene.triangle_light.insert(scene.triangle_light.end(), {-1, -1});
   // Light from +x above: the shadow falls on x in [-1.5, -0.5]. The camera sits below the
   // occluder, looking straight down at x = -1.
-  scene.distant_lights.push_back(distant_light(make_float3(-1.0f, 0.0f, -1.0f), E));
+  scene.infinite_lights.push_back(distant_light(make_float3(-1.0f, 0.0f, -1.0f), E));
   scene.camera.position = make_float3(-1.0f, 0.0f, 0.5f);
   scene.camera.look_at = make_float3(-1.0f, 0.0f, 0.0f);
   Film film = render(scene, "tree", 4);
@@ -229,11 +229,11 @@ TEST(DistantLight, JsonScenes) {
       head +
           R"("lights": [{"type": "distant", "direction": [0, 0, -2], "irradiance": [1, 2, 3]}]})",
       "sun.json", ".");
-  ASSERT_EQ(s.distant_lights.size(), 1u);
+  ASSERT_EQ(s.infinite_lights.size(), 1u);
   EXPECT_TRUE(s.lights.empty());
-  EXPECT_EQ(s.distant_lights[0].type, LIGHT_DISTANT);
-  EXPECT_FLOAT_EQ(s.distant_lights[0].e1.z, 1.0f); // towards the light
-  EXPECT_FLOAT_EQ(s.distant_lights[0].emission.y, 2.0f);
+  EXPECT_EQ(s.infinite_lights[0].type, LIGHT_DISTANT);
+  EXPECT_FLOAT_EQ(s.infinite_lights[0].e1.z, 1.0f); // towards the light
+  EXPECT_FLOAT_EQ(s.infinite_lights[0].emission.y, 2.0f);
 
   auto refused = [&](const std::string& lights_and_more, const std::string& what) {
     try {
@@ -269,15 +269,15 @@ TEST(DistantLight, PbrtLightSource) {
             "\"rgb L\" [1 2 3] \"float scale\" 2\n"
             "LightSource \"distant\" \"rgb L\" [1 1 1] \"float illuminance\" 10\n",
       "sun.pbrt", ".", SceneLoadOptions{});
-  ASSERT_EQ(s.distant_lights.size(), 2u);
+  ASSERT_EQ(s.infinite_lights.size(), 2u);
   EXPECT_TRUE(s.lights.empty());
-  const Light& a = s.distant_lights[0];
+  const Light& a = s.infinite_lights[0];
   // from - to = (1, 0, 1), rotated 90 degrees about z: (0, 1, 1) / sqrt(2) towards the light.
   EXPECT_NEAR(a.e1.x, 0.0f, 1e-6f);
   EXPECT_NEAR(a.e1.y, 1.0f / std::sqrt(2.0f), 1e-6f);
   EXPECT_NEAR(a.e1.z, 1.0f / std::sqrt(2.0f), 1e-6f);
   EXPECT_FLOAT_EQ(a.emission.z, 6.0f);
-  const Light& b = s.distant_lights[1];
+  const Light& b = s.infinite_lights[1];
   // Defaults from (0 0 0) to (0 0 1): light travelling +z, so towards -z; rotated: still -z.
   EXPECT_NEAR(b.e1.z, -1.0f, 1e-6f);
   EXPECT_FLOAT_EQ(b.emission.x, 10.0f);

@@ -22,15 +22,24 @@
 INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers* sc,
                                   const PathBuffers* pb, int path, int light, float pmf, LtRng* rng,
                                   GLOBAL ShadowItem* out) {
-  float u1 = lt_rng_next(rng);
-  float u2 = lt_rng_next(rng);
+  if (!(pmf > 0.0f)) return 0;
   LightPoint lp;
-  if (!(pmf > 0.0f) || !light_point_sample(ls, sc, pb, path, light, u1, u2, &lp)) return 0;
+  if (HAS_LIGHT_ENVIRONMENT && IS_LIGHT(&ls->lights[light], LIGHT_ENVIRONMENT)) {
+    LightSample s = env_light_sample(ls, &ls->lights[light], light_query_normal(pb, path),
+                                     xyz_of(pb->shade_P[path]), rng);
+    if (!light_point_from(sc, pb, path, s, &lp)) return 0;
+  } else {
+    float u1 = lt_rng_next(rng);
+    float u2 = lt_rng_next(rng);
+    if (!light_point_sample(ls, sc, pb, path, light, u1, u2, &lp)) return 0;
+  }
   float f_w = pb->shade_f[path].w;
   float w = 1.0f;
   float p_L = pmf * lp.s.pdf;
-  if (HAS_LIGHT_DISTANT && light >= ls->light_count) {
-    // A distant light: no other technique finds it (a delta direction, outside the tree).
+  if (HAS_INFINITE_LIGHT && light >= ls->light_count) {
+    // A light at infinity is outside the tree: BSDF sampling is its only other technique (a ray
+    // that escapes, shade_surface.h; never for a distant light's delta direction: bsdf_pdf 0).
+    if (CANOPY_MIS && f_w > 0.0f) w = power_heuristic(p_L, lp.bsdf_pdf);
   } else if (HAS_MICROFACET && light_sampler_brdf(ls) && f_w == BRDF_POINT_FLAG) {
     // A glossy point: against its N BRDF-aware samples (brdf_mis.h).
     w = brdf_weight_tree(ls, p_L, brdf_light_pmf_weight(ls, pb, path, light) * lp.s.pdf,
@@ -64,12 +73,12 @@ INLINE int light_pick_items(const LightSamplerCtx* ls, const SceneBuffers* sc,
 // every shading point takes each of them with probability 1 (a shadow ray per distant light and
 // point). They have no position, so the tree has no place for them; pbrt-v4 instead picks among
 // its n infinite lights and the tree with probability n / (n + 1) and 1 / (n + 1). The choice was
-// measured (docs/performance.md, "Distant lights"). At most MAX_DISTANT_LIGHTS, so that they and
+// measured (docs/performance.md, "Distant lights"). At most MAX_INFINITE_LIGHTS, so that they and
 // the root's own pick fit its LIGHT_PICK_SHADOW_SLOTS.
-INLINE int light_pick_distant(const LightSamplerCtx* ls, const SceneBuffers* sc,
+INLINE int light_pick_infinite(const LightSamplerCtx* ls, const SceneBuffers* sc,
                               const PathBuffers* pb, int path, uint seed, GLOBAL ShadowItem* out) {
   int n = 0;
-  for (int j = 0; j < ls->distant_count; ++j) {
+  for (int j = 0; j < ls->infinite_count; ++j) {
     LtRng rng = lt_rng_make(seed, 0x40000000u ^ (uint)j); // apart from codes and leaf lights
     n += light_pick_shadow_item(ls, sc, pb, path, ls->light_count + j, 1.0f, &rng, &out[n]);
   }
@@ -96,9 +105,9 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
     seed = float_as_uint_(pb->shade_N[path].w);
   }
   const LtTree* t = &ls->tree;
-  if (HAS_LIGHT_DISTANT && !segment && it.code == 0 && ls->distant_count > 0) {
-    out.y = light_pick_distant(ls, sc, pb, path, seed, shadows);
-    out.z = ls->distant_count;
+  if (HAS_INFINITE_LIGHT && !segment && it.code == 0 && ls->infinite_count > 0) {
+    out.y = light_pick_infinite(ls, sc, pb, path, seed, shadows);
+    out.z = ls->infinite_count;
     // No other light (the tree is empty), or a glossy point of brdf-oriented, whose BRDF-oriented
     // samples (brdf_mis.h) are its only light samples of the others.
     int brdf_only = HAS_MICROFACET ? ls->kind == SAMPLER_BRDF_ORIENTED &&

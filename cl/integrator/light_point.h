@@ -22,12 +22,11 @@ typedef struct LightPoint {
   float4 origin, dir; // the shadow ray (dir.w: path)
 } LightPoint;
 
-INLINE int light_point_sample(const LightSamplerCtx* ls, const SceneBuffers* sc,
-                              const PathBuffers* pb, int path, int light, float u1, float u2,
-                              LightPoint* lp) {
+// What the light sample s (drawn for the shading point of `path`) brings there (see LightPoint).
+INLINE int light_point_from(const SceneBuffers* sc, const PathBuffers* pb, int path, LightSample s,
+                            LightPoint* lp) {
   float3 P = xyz_of(pb->shade_P[path]);
   float3 N = xyz_of(pb->shade_N[path]);
-  LightSample s = sample_light(&ls->lights[light], P, u1, u2);
   // Light arriving from below the geometric surface would leak through it (shading normals).
   if (!(s.pdf > 0.0f) || !(dot(N, s.wi) > 0.0f) || !(max3(s.Li) > 0.0f)) return 0;
   float4 ns_m = pb->shade_Ns[path];
@@ -48,7 +47,7 @@ INLINE int light_point_sample(const LightSamplerCtx* ls, const SceneBuffers* sc,
     lp->bsdf_pdf = bsdf_pdf(&m, wo, wi);
   }
   if (s.is_delta) lp->bsdf_pdf = 0.0f; // BSDF sampling never finds a point light
-  if (HAS_LIGHT_DISTANT && s.dist == FLT_INF) { // a distant light: an unbounded shadow ray
+  if (HAS_INFINITE_LIGHT && s.dist == FLT_INF) { // a light at infinity: an unbounded shadow ray
     lp->origin = f4_from3(P, FLT_INF);
     lp->dir = f4_from3(s.wi, uint_as_float_((uint)path));
     lp->s = s;
@@ -64,6 +63,26 @@ INLINE int light_point_sample(const LightSamplerCtx* ls, const SceneBuffers* sc,
   lp->dir = f4_from3(to / dist, uint_as_float_((uint)path));
   lp->s = s;
   return 1;
+}
+
+// A direction towards environment light l for the shading point P with light-query normal N
+// (cl/lights/environment.h), as a light sample at infinity.
+INLINE LightSample env_light_sample(const LightSamplerCtx* ls, const GLOBAL Light* l, float3 N,
+                                    float3 P, LtRng* rng) {
+  LightSample s;
+  s.dist = FLT_INF;
+  s.is_delta = 0;
+  s.x = P;
+  s.wi = env_sample(l, &ls->env, N, rng, &s.pdf, &s.Li);
+  return s;
+}
+
+// Samples a point on `light` for the shading point of `path` (sample_light) with (u1, u2).
+INLINE int light_point_sample(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                              const PathBuffers* pb, int path, int light, float u1, float u2,
+                              LightPoint* lp) {
+  return light_point_from(sc, pb, path,
+                          sample_light(&ls->lights[light], xyz_of(pb->shade_P[path]), u1, u2), lp);
 }
 
 #endif // CANOPY_INTEGRATOR_LIGHT_POINT_H

@@ -6,6 +6,7 @@
 #ifndef CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 #define CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 
+#include "../lights/environment.h"
 #include "../light_tree/pmf.h"
 #include "../light_tree/query.h"
 #include "../light_tree/traverse.h"
@@ -29,9 +30,11 @@ typedef struct LightSamplerCtx {
   float brdf_lambda;
   int brdf_nmax;
   int brdf_adaptive;
-  // Distant lights: lights[light_count .. light_count + distant_count), outside every technique
-  // above; each shading point samples all of them (light_pick.h).
-  int distant_count;
+  // Lights at infinity (distant and environment lights): lights[light_count .. light_count +
+  // infinite_count), outside every technique above; each shading point samples all of them
+  // (light_pick.h). env: the environment maps' buffers (cl/lights/environment.h).
+  int infinite_count;
+  EnvBuffers env;
 } LightSamplerCtx;
 
 // Cut budget of a medium segment's root (Conty Estevez & Kulla 2018, §5.4, last paragraph: the
@@ -102,6 +105,14 @@ INLINE float light_sampler_pmf_q(const LightSamplerCtx* ls, const LtQuery* q, in
 INLINE float light_sampler_pmf(const LightSamplerCtx* ls, float3 P, float3 N, int light) {
   LtQuery q = lt_query_point(P, N);
   return light_sampler_pmf_q(ls, &q, light);
+}
+
+// Whether the scene has an environment light among its lights at infinity.
+INLINE int light_sampler_has_environment(const LightSamplerCtx* ls) {
+  if (!HAS_LIGHT_ENVIRONMENT) return 0;
+  for (int j = 0; j < ls->infinite_count; ++j)
+    if (ls->lights[ls->light_count + j].type == LIGHT_ENVIRONMENT) return 1;
+  return 0;
 }
 
 // brdf-mis and brdf-oriented are tree-split at points without a glossy BRDF.

@@ -45,11 +45,33 @@ INLINE float shade_emission_weight(const LightSamplerCtx* ls, const SceneBuffers
   return power_heuristic(prev_P.w, p_light);
 }
 
+// MIS weight of environment light l found by a ray that escaped along d: as for an emitter hit
+// (shade_emission_weight), against the environment's own sampling (light_pick.h samples every
+// light at infinity with probability 1, with the pdf env_pdf at the previous vertex's normal).
+INLINE float shade_environment_weight(const LightSamplerCtx* ls, const PathBuffers* pb, int path,
+                                      int depth, const GLOBAL Light* l, float3 d) {
+  float4 prev_P = pb->shade_P[path];
+  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
+  if (!CANOPY_MIS) return 0.0f; // light sampling alone accounts for it
+  return power_heuristic(prev_P.w, env_pdf(l, &ls->env, light_query_normal(pb, path), d));
+}
+
 INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBuffers* sc,
                                const PathBuffers* pb, const LightSamplerCtx* ls) {
   int2 out = make_int2(0, 0);
   Hit h = pb->hits[path];
-  if (h.prim < 0) { // escaped (no environment light), or scattered in the medium (shade_volume.h)
+  if (HAS_LIGHT_ENVIRONMENT && h.prim == -1) { // escaped: the environment lights it sees
+    float3 d = xyz_of(pb->ray_d[path]);
+    float3 sum = make_float3(0.0f, 0.0f, 0.0f);
+    for (int j = 0; j < ls->infinite_count; ++j) {
+      GLOBAL const Light* l = &ls->lights[ls->light_count + j];
+      if (l->type == LIGHT_ENVIRONMENT)
+        sum += env_radiance(l, &ls->env, d) * shade_environment_weight(ls, pb, path, depth, l, d);
+    }
+    float4 L = pb->radiance[path];
+    pb->radiance[path] = f4_from3(xyz_of(L) + xyz_of(pb->throughput[path]) * sum, 0.0f);
+  }
+  if (h.prim < 0) { // escaped, or scattered in the medium (shade_volume.h)
     // and no glossy point: brdf_sample must not act on a stale (or never written) brdf_state
     if (HAS_MICROFACET && light_sampler_brdf(ls)) pb->brdf_state[path] = make_int4(0, 0, 0, 0);
     return out;
@@ -95,7 +117,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   int last = depth + 1 >= max_depth; // the BSDF ray only looks for emission (see the top)
   // Light shapes are black diffuse: nothing to pick lights for.
   int black = m.type == MATERIAL_DIFFUSE && !(max3(xyz_of(m.albedo)) > 0.0f);
-  out.y = (ls->light_count > 0 || ls->distant_count > 0) && ls->kind != SAMPLER_BSDF &&
+  out.y = (ls->light_count > 0 || ls->infinite_count > 0) && ls->kind != SAMPLER_BSDF &&
           bsdf_has_smooth_lobe(&m) && !black;
   float mis_flag = CANOPY_MIS ? 1.0f : 0.0f;
   if (HAS_MICROFACET && light_sampler_brdf(ls)) {
@@ -105,7 +127,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
     pb->brdf_state[path] = make_int4(0, glossy ? -1 : 0, 0, 0);
     if (glossy) mis_flag = BRDF_POINT_FLAG;
     // (distant lights are still sampled there: light_pick.h)
-    if (glossy && ls->kind == SAMPLER_BRDF_ORIENTED) out.y = ls->distant_count > 0;
+    if (glossy && ls->kind == SAMPLER_BRDF_ORIENTED) out.y = ls->infinite_count > 0;
   }
   pb->shade_N[path] = f4_from3(N, uint_as_float_(light_seed));
   pb->shade_f[path] = f4_from3(beta, mis_flag);
@@ -117,7 +139,10 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   Frame fr = frame_from(Ns);
   BsdfSample bs = bsdf_sample(&m, frame_to_local(&fr, wo), make_float3(u1, u2, u3));
   // From the last vertex, only a ray whose emission gets a weight (shade_emission_weight).
-  if (last && !bs.is_delta && ls->kind != SAMPLER_BSDF && !(mis_flag == 1.0f)) return out;
+  // (An environment light gives an escaped ray a weight at glossy points of the BRDF samplers too.)
+  int env_weighs = CANOPY_MIS ? light_sampler_has_environment(ls) : 0;
+  if (last && !bs.is_delta && ls->kind != SAMPLER_BSDF && !(mis_flag == 1.0f) && !env_weighs)
+    return out;
   float3 wi = frame_to_world(&fr, bs.wi);
   // A direction into the geometric surface would leak light through it (shading normals).
   if (!(dot(wi, N) > 0.0f)) return out;

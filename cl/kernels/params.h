@@ -39,7 +39,9 @@
       __global const float4 *lt_nodes, __global const int4 *lt_children,                           \
       __global const int *lt_leaf_lights, __global const uint *lt_trails, float4 lt_root_sphere,   \
       float4 lt_root_info, float split_threshold, uint max_cut, __global float2 *brdf_cut,         \
-      float brdf_delta, float brdf_lambda, int brdf_nmax, int brdf_adaptive, int distant_count,
+      float brdf_delta, float brdf_lambda, int brdf_nmax, int brdf_adaptive, int infinite_count,   \
+      __global const float4 *env_texels, __global const float *env_pmf,                            \
+      __global const float *env_alias_prob, __global const int *env_alias_index,
 
 #define LIGHT_SAMPLER_ASSEMBLE(ls)                                                                 \
   LightSamplerCtx ls;                                                                              \
@@ -63,7 +65,11 @@
   ls.brdf_lambda = brdf_lambda;                                                                    \
   ls.brdf_nmax = brdf_nmax;                                                                        \
   ls.brdf_adaptive = brdf_adaptive;                                                                \
-  ls.distant_count = HAS_LIGHT_DISTANT ? distant_count : 0
+  ls.infinite_count = HAS_INFINITE_LIGHT ? infinite_count : 0;                                    \
+  ls.env.texels = env_texels;                                                                      \
+  ls.env.pmf = env_pmf;                                                                            \
+  ls.env.alias_prob = env_alias_prob;                                                              \
+  ls.env.alias_index = env_alias_index
 
 // An exclusive scan's input (counts) and result (block_sums[i / block] + offsets[i]).
 #define SCAN_PARAMS                                                                                \

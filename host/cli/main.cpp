@@ -332,7 +332,7 @@ int run_render(const RenderArgs& args) {
   if (!args.stats_json.empty()) check_writable(args.stats_json, "--stats-json");
 
   const std::string scene_name = printable(args.scene, 1024);
-  if (scene.lights.empty() && scene.distant_lights.empty())
+  if (scene.lights.empty() && scene.infinite_lights.empty())
     std::fprintf(
         stderr, "canopy: warning: %s: the scene has no emitters%s; the image is black\n",
         scene_name.c_str(),
@@ -401,8 +401,8 @@ int run_render(const RenderArgs& args) {
     write_png(args.emitter_mask, mask_to_image(film.emitter_mask(), film.width, film.height));
   const RenderStats& st = renderer.stats();
   std::string skipped =
-      (scene.distant_lights.empty() ? std::string()
-                                    : fmt::format(" and {} distant", scene.distant_lights.size())) +
+      (scene.infinite_lights.empty() ? std::string()
+                                    : fmt::format(" and {} distant", scene.infinite_lights.size())) +
       (scene.skipped_lights ? fmt::format(" ({} with zero emission skipped)", scene.skipped_lights)
                             : std::string());
   std::string part_text;
@@ -438,7 +438,7 @@ int run_render(const RenderArgs& args) {
     j["spp"] = scene.integrator.spp;
     j["film"] = {scene.film.width, scene.film.height};
     j["lights"] = scene.lights.size();
-    j["distant_lights"] = scene.distant_lights.size();
+    j["infinite_lights"] = scene.infinite_lights.size();
     j["device"] = rt.device_name();
     std::ofstream out(args.stats_json);
     if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.stats_json));

@@ -20,10 +20,6 @@ void check_sizes(const RgbImage& a, const RgbImage& b) {
         fmt::format("image sizes differ: {}x{} and {}x{}", a.width, a.height, b.width, b.height));
 }
 
-float srgb_decode(float v) {
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
-
 } // namespace
 
 ImageMetrics compare_images(const RgbImage& test, const RgbImage& reference, double rel_epsilon) {

@@ -15,6 +15,10 @@
 
 namespace canopy {
 
+float srgb_decode(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
 float srgb_encode(float x) {
   x = std::clamp(x, 0.0f, 1.0f);
   return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;

@@ -34,5 +34,7 @@ void write_png(const std::filesystem::path& file, const RgbImage& img);
 RgbImage read_image(const std::filesystem::path& file);
 
 float srgb_encode(float linear);
+// The inverse of srgb_encode: an sRGB-encoded value in [0, 1] to linear.
+float srgb_decode(float encoded);
 
 } // namespace canopy

@@ -42,7 +42,8 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
                                 const std::vector<Material>& materials,
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
                                 int emission_exponent, const Medium& medium,
-                                const std::vector<Light>& distant_lights) {
+                                const std::vector<Light>& infinite_lights,
+                                const EnvironmentData& environment) {
   DeviceScene d;
   d.nodes = upload_buffer(ctx, geometry.bvh.nodes);
   d.leaf_blocks = upload_buffer(ctx, geometry.bvh.leaf_blocks);
@@ -50,15 +51,20 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
   d.materials = upload_buffer(ctx, materials);
   d.shading_normals = upload_buffer(ctx, geometry.shading_normals); // one element when empty
   d.medium = upload_buffer(ctx, std::vector<Medium>{medium});
-  upload_light_sampler(ctx, lights, sampler, emission_exponent, d, distant_lights);
+  upload_light_sampler(ctx, lights, sampler, emission_exponent, d, infinite_lights, environment);
   return d;
 }
 
 void upload_light_sampler(const cl::Context& ctx, const std::vector<Light>& lights,
                           const LightSamplerData& sampler, int emission_exponent, DeviceScene& d,
-                          const std::vector<Light>& distant_lights) {
-  d.lights = upload_scaled_lights(ctx, lights, distant_lights, emission_exponent);
-  d.distant_count = int(distant_lights.size());
+                          const std::vector<Light>& infinite_lights,
+                          const EnvironmentData& environment) {
+  d.env_texels = upload_buffer(ctx, environment.texels);
+  d.env_pmf = upload_buffer(ctx, environment.pmf);
+  d.env_alias_prob = upload_buffer(ctx, environment.alias_prob);
+  d.env_alias_index = upload_buffer(ctx, environment.alias_index);
+  d.lights = upload_scaled_lights(ctx, lights, infinite_lights, emission_exponent);
+  d.infinite_count = int(infinite_lights.size());
   d.power_pmf = upload_buffer(ctx, sampler.power_pmf);
   d.alias_prob = upload_buffer(ctx, sampler.alias_prob);
   d.alias_index = upload_buffer(ctx, sampler.alias_index);
@@ -79,7 +85,11 @@ void DeviceScene::set_args(KernelArgs& args) const {
   SCENE_BUFFERS(CANOPY_SET_SCENE_ARG)
 #undef CANOPY_SET_SCENE_ARG
   args.set("light_count", cl_int(light_count));
-  args.set("distant_count", cl_int(distant_count));
+  args.set("infinite_count", cl_int(infinite_count));
+  args.set("env_texels", env_texels);
+  args.set("env_pmf", env_pmf);
+  args.set("env_alias_prob", env_alias_prob);
+  args.set("env_alias_index", env_alias_index);
   args.set("lights", lights);
   args.set("power_pmf", power_pmf);
   args.set("alias_prob", alias_prob);

@@ -6,6 +6,7 @@
 #include "accel/bvh.h"
 #include "cl/kernel_args.h"
 #include "integrator/path_state.h"
+#include "render/environment_map.h"
 #include "render/light_sampler_data.h"
 
 #include <CL/opencl.hpp>
@@ -30,8 +31,9 @@ struct DeviceScene {
 #undef CANOPY_DEVICE_SCENE_BUFFER
   cl::Buffer lights;
   cl::Buffer power_pmf, alias_prob, alias_index, lt_nodes, lt_children, lt_leaf_lights, lt_trails;
+  cl::Buffer env_texels, env_pmf, env_alias_prob, env_alias_index; // EnvironmentData
   int light_count = 0;
-  int distant_count = 0; // distant lights, after the light_count others in `lights`
+  int infinite_count = 0; // distant lights, after the light_count others in `lights`
   float4 root_sphere{0, 0, 0, 0}, root_info{0, 0, 0, 0};
   float split_threshold = 0.0f;
   uint32_t max_cut = 1;
@@ -51,12 +53,14 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
                                 const std::vector<Material>& materials,
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
                                 int emission_exponent = 0, const Medium& medium = {},
-                                const std::vector<Light>& distant_lights = {});
+                                const std::vector<Light>& infinite_lights = {},
+                                const EnvironmentData& environment = {});
 
 // Uploads only the lights and the light sampler's buffers into `d` (the part of
 // upload_device_scene that the pick tests and benchmarks need without any geometry).
 void upload_light_sampler(const cl::Context& ctx, const std::vector<Light>& lights,
                           const LightSamplerData& sampler, int emission_exponent, DeviceScene& d,
-                          const std::vector<Light>& distant_lights = {});
+                          const std::vector<Light>& infinite_lights = {},
+                          const EnvironmentData& environment = {});
 
 } // namespace canopy

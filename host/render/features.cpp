@@ -24,7 +24,7 @@ const char* light_sampler_name(int kind) {
 KernelFeatures KernelFeatures::all(int light_sampler) {
   KernelFeatures f;
   f.light_point = f.light_spot = f.light_sphere = f.light_quad = f.light_triangle = true;
-  f.light_disk = f.light_distant = true;
+  f.light_disk = f.light_distant = f.light_environment = true;
   f.prim_sphere = f.prim_disk = true;
   f.material_conductor = f.material_plastic = true;
   f.medium = true;
@@ -33,16 +33,17 @@ KernelFeatures KernelFeatures::all(int light_sampler) {
 }
 
 std::string KernelFeatures::build_options() const {
-  return fmt::format(
-      "-DCANOPY_FEATURES_SET -DHAS_LIGHT_POINT={} -DHAS_LIGHT_SPOT={} "
-      "-DHAS_LIGHT_SPHERE={} -DHAS_LIGHT_QUAD={} -DHAS_LIGHT_TRIANGLE={} "
-      "-DHAS_LIGHT_DISK={} -DHAS_LIGHT_DISTANT={} -DHAS_PRIM_SPHERE={} -DHAS_PRIM_DISK={} "
-      "-DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} -DHAS_MEDIUM={} "
-      "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={} -DCANOPY_VOLUME_MIDPOINT={}",
-      int(light_point), int(light_spot), int(light_sphere), int(light_quad), int(light_triangle),
-      int(light_disk), int(light_distant), int(prim_sphere), int(prim_disk),
-      int(material_conductor), int(material_plastic), int(medium), light_sampler, int(mis),
-      int(volume_midpoint));
+  return fmt::format("-DCANOPY_FEATURES_SET -DHAS_LIGHT_POINT={} -DHAS_LIGHT_SPOT={} "
+                     "-DHAS_LIGHT_SPHERE={} -DHAS_LIGHT_QUAD={} -DHAS_LIGHT_TRIANGLE={} "
+                     "-DHAS_LIGHT_DISK={} -DHAS_LIGHT_DISTANT={} -DHAS_LIGHT_ENVIRONMENT={} "
+                     "-DHAS_PRIM_SPHERE={} -DHAS_PRIM_DISK={} "
+                     "-DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} -DHAS_MEDIUM={} "
+                     "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={} -DCANOPY_VOLUME_MIDPOINT={}",
+                     int(light_point), int(light_spot), int(light_sphere), int(light_quad),
+                     int(light_triangle), int(light_disk), int(light_distant),
+                     int(light_environment), int(prim_sphere), int(prim_disk),
+                     int(material_conductor), int(material_plastic), int(medium), light_sampler,
+                     int(mis), int(volume_midpoint));
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {
@@ -72,7 +73,10 @@ KernelFeatures scene_features(const Scene& scene, int light_sampler) {
       break;
     }
   }
-  f.light_distant = !scene.distant_lights.empty();
+  for (const Light& l : scene.infinite_lights) {
+    f.light_distant |= l.type == LIGHT_DISTANT;
+    f.light_environment |= l.type == LIGHT_ENVIRONMENT;
+  }
   f.medium = scene.has_medium;
   f.volume_midpoint = scene.has_medium && scene.integrator.volume_importance == "midpoint";
   for (const MaterialDesc& m : scene.materials) {

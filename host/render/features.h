@@ -10,7 +10,7 @@ namespace canopy {
 
 struct KernelFeatures {
   bool light_point = false, light_spot = false, light_sphere = false, light_quad = false,
-       light_triangle = false, light_disk = false, light_distant = false;
+       light_triangle = false, light_disk = false, light_distant = false, light_environment = false;
   bool prim_sphere = false, prim_disk = false;
   bool material_conductor = false, material_plastic = false;
   bool medium = false;          // a participating medium (cl/volume/, shade_volume)

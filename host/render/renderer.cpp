@@ -143,13 +143,16 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   t0 = Clock::now();
   const cl::Context& ctx = rt.context();
   // The exponent of the brightest emission of either list (0 for an empty list: not a candidate).
-  stats_.emission_exponent = scene.distant_lights.empty() ? emission_scale_exponent(scene.lights)
+  stats_.emission_exponent = scene.infinite_lights.empty() ? emission_scale_exponent(scene.lights)
                              : scene.lights.empty()
-                                 ? emission_scale_exponent(scene.distant_lights)
+                                 ? emission_scale_exponent(scene.infinite_lights)
                                  : std::max(emission_scale_exponent(scene.lights),
-                                            emission_scale_exponent(scene.distant_lights));
+                                            emission_scale_exponent(scene.infinite_lights));
+  // Environment maps are read here (not by the scene loader): the texels go to the device only.
+  std::vector<Light> infinite = scene.infinite_lights;
+  EnvironmentData environment = build_environment_data(infinite, scene.environment_maps);
   device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
-                                stats_.emission_exponent, scene.medium, scene.distant_lights);
+                                stats_.emission_exponent, scene.medium, infinite, environment);
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
   camera_ = upload_buffer(ctx, cam);
@@ -201,7 +204,7 @@ Film Renderer::render(const RenderSettings& settings) {
       std::min<size_t>(sampler_.max_cut, light_sampler_segment_budget(sampler_.root_budget()));
   // A shading point's distant lights (light_pick.h) come on top of its cut.
   const size_t cut_items =
-      size_t(sampler_.max_cut) + (medium ? segment_items : 0u) + scene_.distant_lights.size();
+      size_t(sampler_.max_cut) + (medium ? segment_items : 0u) + scene_.infinite_lights.size();
   size_t wave =
       std::max<size_t>(1, std::min(settings.wave_size, options_.split_queue_items / cut_items));
   const size_t W = size_t(std::min<uint64_t>(total, wave));

@@ -71,8 +71,10 @@ float3 position(const JsonObject& o, std::string_view key, bool is_template, flo
 
 Light parse_light(const JsonValue& v, bool is_template, double3 origin) {
   auto o = v.as_object();
-  std::string type =
-      o.req("type").as_enum({"point", "spot", "sphere", "quad", "triangle", "disk", "distant"});
+  std::string type = o.req("type").as_enum(
+      {"point", "spot", "sphere", "quad", "triangle", "disk", "distant", "environment"});
+  if (type == "environment")
+    o.req("type").fail("an environment light cannot be a light set template");
   Light l{};
   l.prim = -1;
   const float3 zero = make_float3(0, 0, 0);
@@ -154,6 +156,63 @@ Light parse_light(const JsonValue& v, bool is_template, double3 origin) {
     l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
     if (!finish_area_light(l)) o.fail("area must be > 0 (the vertices are collinear)");
   }
+  return l;
+}
+
+void set_environment_frame(Light& l, double3 up, double3 front) {
+  double ul = std::sqrt(up.x * up.x + up.y * up.y + up.z * up.z);
+  double3 n{up.x / ul, up.y / ul, up.z / ul};
+  // The image's centre (u = 0.5: phi = pi, towards -e1) looks along `front` made perpendicular to
+  // the pole; e2 = n x e1 completes the frame.
+  double fn = front.x * n.x + front.y * n.y + front.z * n.z;
+  double3 f{front.x - fn * n.x, front.y - fn * n.y, front.z - fn * n.z};
+  double fl = std::sqrt(f.x * f.x + f.y * f.y + f.z * f.z);
+  double3 e1{-f.x / fl, -f.y / fl, -f.z / fl};
+  double3 e2{n.y * e1.z - n.z * e1.y, n.z * e1.x - n.x * e1.z, n.x * e1.y - n.y * e1.x};
+  l.e1 = make_float4(float(e1.x), float(e1.y), float(e1.z), 0.0f);
+  l.e2 = make_float4(float(e2.x), float(e2.y), float(e2.z), 0.0f);
+  l.n = make_float4(float(n.x), float(n.y), float(n.z), 0.0f);
+}
+
+Light parse_environment_light(const JsonValue& v, Builder& b) {
+  auto o = v.as_object();
+  Light l{};
+  l.type = LIGHT_ENVIRONMENT;
+  l.prim = -1;
+  l.pad = -1;
+  set_environment_frame(l, {0, 1, 0}, {0, 0, -1});
+  if (!o.has("map")) {
+    o.allow({"type", "radiance"});
+    l.emission = f4_from3(o.req("radiance").as_emission(), 0.0f);
+    return l;
+  }
+  o.allow({"type", "map", "scale", "projection", "up", "front"});
+  auto mv = o.req("map");
+  std::string f = mv.as_string();
+  if (f.empty()) mv.fail("must not be empty");
+  std::filesystem::path p(f);
+  if (p.is_relative()) p = b.base_dir / p;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(p, ec))
+    mv.fail(fmt::format("{}: no such file", p.string()));
+  EnvironmentMap map;
+  map.file = p;
+  map.projection = ENV_EQUIRECT;
+  if (auto pv = o.get("projection"))
+    map.projection =
+        pv->as_enum({"equirect", "octahedral"}) == "equirect" ? ENV_EQUIRECT : ENV_OCTAHEDRAL;
+  l.emission = make_float4(1, 1, 1, 0);
+  if (auto sv = o.get("scale")) l.emission = f4_from3(sv->as_emission(), 0.0f);
+  float3 up = make_float3(0, 1, 0), front = make_float3(0, 0, -1);
+  if (auto uv = o.get("up")) up = uv->as_vec3_nonzero();
+  if (auto fv = o.get("front")) front = fv->as_vec3_nonzero();
+  // front must not be along up (it fixes the azimuth)
+  float3 un = normalize(up);
+  float3 fp = front - un * dot(front, un);
+  if (!(length(fp) > 1e-6f * length(front))) o.req("front").fail("must not be parallel to up");
+  set_environment_frame(l, {up.x, up.y, up.z}, {front.x, front.y, front.z});
+  l.pad = int(b.scene.environment_maps.size());
+  b.scene.environment_maps.push_back(map);
   return l;
 }
 

@@ -187,16 +187,23 @@ void check_vertices(const Scene& s, size_t first_vertex, const JsonValue& at,
                     std::string_view what);
 // True if the light has a non-zero emission.
 bool emits(const Light& l);
-// Adds a distant light (LIGHT_DISTANT) to scene.distant_lights, or calls fail (which throws) with
-// the reason it cannot be rendered: a medium in the scene, or more than MAX_DISTANT_LIGHTS.
-void add_distant_light(Scene& scene, const Light& l,
-                       const std::function<void(const std::string&)>& fail);
+// Adds a distant light (LIGHT_DISTANT) to scene.infinite_lights, or calls fail (which throws) with
+// the reason it cannot be rendered: a medium in the scene, or more than MAX_INFINITE_LIGHTS.
+void add_infinite_light(Scene& scene, const Light& l,
+                        const std::function<void(const std::string&)>& fail);
 
 // Lights (lights.cpp).
 // An analytic light from a JSON object, its positions rebased to `origin` (the scene origin). As a
 // template of a light set, position-like keys are offsets from the generated site (`origin` is not
 // used) and may be omitted (quad/triangle are then centred on the site).
 Light parse_light(const JsonValue& v, bool is_template, double3 origin);
+// A JSON "environment" light (docs/scene-format.md): constant `radiance`, or a `map` file (resolved
+// against the scene's directory, appended to scene.environment_maps: Light::pad) with `scale`,
+// `projection`, and the frame given by `up` and `front`.
+Light parse_environment_light(const JsonValue& v, Builder& b);
+// The map frame of an environment light (cl/lights/environment.h): pole `up`, the image's centre
+// towards `front` (made perpendicular to up); both non-zero, not parallel.
+void set_environment_frame(Light& l, double3 up, double3 front);
 // Fills n (unit normal, area in w) of a quad/triangle light; false if the area is zero.
 bool finish_area_light(Light& l);
 // Fills n (unit normal of `normal`, area in w) and the tangent frame e1, e2 of a disk light whose

@@ -480,7 +480,9 @@ private:
   void camera(const Token& d, Params& p, const std::string& type);
   void finish_camera(const Loc& loc);
   void shape(const Token& d, Params& p, const std::string& type);
-  void light_source(const Token& d, Params& p, const std::string& type);
+  void light_source(const Token& d, Params& p, const std::string& type,
+                    const std::filesystem::path& base_dir);
+  void infinite_light(const Token& d, Params& p, const std::filesystem::path& dir);
   void area_light(const Token& d, Params& p, const std::string& type);
   int material(const Loc& loc, Params& p, const std::string& type, const std::string& name);
   void add_mesh(const Loc& loc, Mesh& m, const Transform& ctm);
@@ -1050,7 +1052,7 @@ void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& d
       shape(d, p, type);
     } else if (k == "LightSource") {
       need_world(true);
-      light_source(d, p, type);
+      light_source(d, p, type, dir);
     } else if (k == "AreaLightSource") {
       need_world(true);
       area_light(d, p, type);
@@ -1357,8 +1359,13 @@ void Reader::shape(const Token& d, Params& p, const std::string& type) {
 }
 
 // The format page, "Lights".
-void Reader::light_source(const Token& d, Params& p, const std::string& type) {
-  if (type != "point" && type != "spot" && type != "distant") {
+void Reader::light_source(const Token& d, Params& p, const std::string& type,
+                          const std::filesystem::path& base_dir) {
+  if (type == "infinite" && !object_) {
+    infinite_light(d, p, base_dir);
+    return;
+  }
+  if (type != "point" && type != "spot" && type != "distant" && type != "infinite") {
     warn(d.loc,
          fmt::format("LightSource \"{}\" is not read in this slice, ignored", printable(type)));
     return;
@@ -1429,9 +1436,60 @@ void Reader::light_source(const Token& d, Params& p, const std::string& type) {
   if (!emits(l))
     ++scene_.skipped_lights;
   else if (distant)
-    add_distant_light(scene_, l, [&](const std::string& e) { fail(d.loc, e); });
+    add_infinite_light(scene_, l, [&](const std::string& e) { fail(d.loc, e); });
   else
     scene_.lights.push_back(l);
+}
+
+// pbrt-v4 "infinite": a constant L, or an equal-area octahedral image ("filename") in light space:
+// the map frame is the current transform's x, y, z (orthonormalised in that order, so a mirror
+// keeps its handedness).
+void Reader::infinite_light(const Token& d, Params& p, const std::filesystem::path& dir) {
+  Light l{};
+  l.type = LIGHT_ENVIRONMENT;
+  l.prim = -1;
+  l.pad = -1;
+  double scale = p.get_float("scale", 1.0);
+  if (!(scale >= 0.0)) fail(d.loc, fmt::format("{}: \"float scale\": must be >= 0", p.what()));
+  for (const char* skip : {"illuminance", "portal"})
+    if (Param* q = p.find(skip))
+      warn(q->loc, fmt::format("{}: \"{} {}\" ignored", p.what(), q->type, skip));
+  Transform xf = world(gs_.ctm);
+  double3 ex = linear(xf, {1, 0, 0}), ey = linear(xf, {0, 1, 0}), ez = linear(xf, {0, 0, 1});
+  auto dot3 = [](double3 a, double3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; };
+  auto unit = [&](double3 a) {
+    double n = len3(a);
+    if (!(n > 0.0) || !std::isfinite(n))
+      fail(d.loc, fmt::format("{}: the transform is singular", p.what()));
+    return double3{a.x / n, a.y / n, a.z / n};
+  };
+  double3 n = unit(ez);
+  double3 e1 = unit(ex - n * dot3(ex, n));
+  double3 e2 = unit(ey - n * dot3(ey, n) - e1 * dot3(ey, e1));
+  l.n = f4_from3(to_float3(n), 0.0f);
+  l.e1 = f4_from3(to_float3(e1), 0.0f);
+  l.e2 = f4_from3(to_float3(e2), 0.0f);
+  if (auto f = p.get_string("filename")) {
+    if (p.find("L")) fail(d.loc, fmt::format("{}: both \"L\" and \"filename\" given", p.what()));
+    std::filesystem::path file(*f);
+    if (file.is_relative()) file = dir / file;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
+      fail(d.loc, fmt::format("{}: \"filename\" {}: no such file", p.what(), file.string()));
+    l.pad = int(scene_.environment_maps.size());
+    scene_.environment_maps.push_back({file, ENV_OCTAHEDRAL});
+    l.emission = f4_from3(to_float3(double3{scale, scale, scale}), 0.0f);
+  } else {
+    float3 L = p.spectrum("L", Params::Use::Illuminant).value_or(make_float3(1, 1, 1));
+    l.emission = f4_from3(to_float3(dvec(L) * scale), 0.0f);
+  }
+  if (!std::isfinite(l.emission.x + l.emission.y + l.emission.z))
+    fail(d.loc, fmt::format("{}: L * scale is too large", p.what()));
+  p.finish();
+  if (!emits(l))
+    ++scene_.skipped_lights;
+  else
+    add_infinite_light(scene_, l, [&](const std::string& e) { fail(d.loc, e); });
 }
 
 void Reader::area_light(const Token& d, Params& p, const std::string& type) {

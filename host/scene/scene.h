@@ -154,6 +154,13 @@ inline MaterialDesc plastic_material(std::string name, float3 albedo, float3 spe
   return d;
 }
 
+// An environment light's radiance map (cl/lights/environment.h): the image file, read by the
+// renderer (host/render/environment_map.h), and its projection (ENV_EQUIRECT, ENV_OCTAHEDRAL).
+struct EnvironmentMap {
+  std::filesystem::path file;
+  int projection = 0;
+};
+
 // All geometry flattened into one world-space triangle soup. Emissive mesh triangles (OBJ/MTL Ke
 // or an emission given in the scene) have a TRIANGLE light with LIGHT_FLAG_FROM_MESH and
 // triangle_light[i] pointing at it. Analytic area lights (sphere, quad, triangle) are NOT in this
@@ -179,9 +186,12 @@ struct Scene {
   std::vector<float3> shading_normals;
   std::vector<int32_t> triangle_normals;
   std::vector<Light> lights; // only lights that emit (zero-emission lights are skipped)
-  // Distant lights (LIGHT_DISTANT, at most MAX_DISTANT_LIGHTS): apart from `lights`, which the
-  // light samplers and the tree cover; every shading point samples each of them.
-  std::vector<Light> distant_lights;
+  // Lights at infinity (LIGHT_DISTANT, LIGHT_ENVIRONMENT; at most MAX_INFINITE_LIGHTS): apart from
+  // `lights`, which the light samplers and the tree cover; every shading point samples each of
+  // them. An environment light with a map has its index in environment_maps in Light::pad (-1:
+  // constant); the renderer loads the map.
+  std::vector<Light> infinite_lights;
+  std::vector<EnvironmentMap> environment_maps;
   // A homogeneous participating medium (the scene's "medium"; cl/types.h Medium), if any.
   bool has_medium = false;
   Medium medium{};

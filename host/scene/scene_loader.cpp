@@ -200,16 +200,19 @@ bool emits(const Light& l) {
   return l.emission.x > 0.0f || l.emission.y > 0.0f || l.emission.z > 0.0f;
 }
 
-void add_distant_light(Scene& scene, const Light& l,
-                       const std::function<void(const std::string&)>& fail) {
-  // Distant lights are sampled at surfaces only (cl/integrator/light_pick.h): in a medium their
-  // light along a ray segment would be missing, so such a scene is refused, not rendered wrong.
+void add_infinite_light(Scene& scene, const Light& l,
+                        const std::function<void(const std::string&)>& fail) {
+  // Lights at infinity are sampled at surfaces only (cl/integrator/light_pick.h): in a medium
+  // their light along a ray segment would be missing, so such a scene is refused, not rendered
+  // wrong.
+  const char* what = l.type == LIGHT_DISTANT ? "distant" : "environment";
   if (scene.has_medium)
-    fail("a distant light in a scene with a medium is not supported (medium points would miss "
-         "its light)");
-  if (scene.distant_lights.size() >= MAX_DISTANT_LIGHTS)
-    fail(fmt::format("more than {} distant lights", MAX_DISTANT_LIGHTS));
-  scene.distant_lights.push_back(l);
+    fail(fmt::format("a {} light in a scene with a medium is not supported (medium points would "
+                     "miss its light)",
+                     what));
+  if (scene.infinite_lights.size() >= MAX_INFINITE_LIGHTS)
+    fail(fmt::format("more than {} distant and environment lights", MAX_INFINITE_LIGHTS));
+  scene.infinite_lights.push_back(l);
 }
 
 // ------------------------------------------------------------------------------ top-level parts
@@ -419,13 +422,15 @@ Scene load_from_string(const std::string& json_text, const std::string& name,
     scene.lights.reserve(scene.lights.size() + n);
     for (size_t i = 0; i < n; ++i) {
       JsonValue lv = x->at(i);
-      Light l = parse_light(lv, false, scene.origin);
+      const bool env =
+          lv.as_object().has("type") && lv.as_object().req("type").as_string() == "environment";
+      Light l = env ? parse_environment_light(lv, b) : parse_light(lv, false, scene.origin);
       if (auto e = check_light_extent(l, scene.origin); !e.empty()) lv.fail(e);
       // A light switched off (zero emission) is skipped: it neither emits nor occludes.
       if (!emits(l))
         ++scene.skipped_lights;
-      else if (l.type == LIGHT_DISTANT)
-        add_distant_light(scene, l, [&](const std::string& e) { lv.fail(e); });
+      else if (l.type == LIGHT_DISTANT || l.type == LIGHT_ENVIRONMENT)
+        add_infinite_light(scene, l, [&](const std::string& e) { lv.fail(e); });
       else
         scene.lights.push_back(l);
     }
