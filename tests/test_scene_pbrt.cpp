@@ -436,7 +436,7 @@ TEST(ScenePbrt, EveryUnknownDirectiveOrParameterWarningNamesFileAndLine) {
                  "Camera \"perspective\" \"float fov\" 50 \"float lensradius\" 0.1\n"
                  "Option \"bool wavefront\" true\n"
                  "WorldBegin\n"
-                 "Shape \"plymesh\" \"string filename\" \"a.ply\"\n"
+                 "Shape \"curve\"\n"
                  "LightSource \"distant\"\n"
                  "LightSource \"infinite\"\n"
                  "Shape \"sphere\" \"float radius\" 1 \"float wobble\" 2\n");
@@ -444,7 +444,7 @@ TEST(ScenePbrt, EveryUnknownDirectiveOrParameterWarningNamesFileAndLine) {
                         "t.pbrt:2: Camera \"perspective\": \"lensradius\": Canopy's camera is a "
                         "pinhole (no thin lens), ignored",
                         "t.pbrt:3: Option",
-                        "t.pbrt:5: Shape \"plymesh\" is not read in this slice",
+                        "t.pbrt:5: Shape \"curve\" is not read in this slice",
                         "t.pbrt:6: LightSource \"distant\" is not read",
                         "t.pbrt:7: LightSource \"infinite\" is not read",
                         "t.pbrt:8: Shape \"sphere\": unknown parameter \"float wobble\" ignored"};
