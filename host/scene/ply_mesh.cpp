@@ -259,6 +259,7 @@ void check_binary(const std::string& d, const Header& h, const std::string& pref
 }
 
 bool numeric(std::string_view tok, bool integer, int64_t* value = nullptr) {
+  if (tok.size() > 1 && tok[0] == '+') tok.remove_prefix(1); // Assimp accepts it; from_chars not
   const char* end = tok.data() + tok.size();
   if (integer) {
     int64_t v = 0;
