@@ -391,6 +391,28 @@ TEST(ScenePly, PlymeshBuildsWhatTheSameTriangleMeshBuilds) {
   }
 }
 
+TEST(ScenePly, AFileWithoutTrianglesIsAWarning) {
+  fs::path d = temp_dir();
+  Ply lines = kQuadAndTriangle;
+  lines.faces = {{0, 4}};
+  Ply points = kQuadAndTriangle;
+  points.faces.clear();
+  write(d / "lines.ply", ply_bytes(lines, Enc::LittleEndian));
+  write(d / "points.ply", ply_bytes(points, Enc::Ascii));
+  Scene s = load_pbrt_scene_from_string(
+      std::string(kCamera) + "Shape \"plymesh\" \"string filename\" \"lines.ply\"\n" +
+          "Shape \"plymesh\" \"string filename\" \"points.ply\"\n",
+      "t.pbrt", d);
+  EXPECT_EQ(s.triangle_count(), 0u);
+  const char* want[] = {
+      "t.pbrt:4: Shape \"plymesh\": 1 faces of fewer than 3 vertices ignored",
+      "t.pbrt:4: Shape \"plymesh\": no faces of 3 or more vertices, nothing added, ignored",
+      "t.pbrt:5: Shape \"plymesh\": no faces of 3 or more vertices, nothing added, ignored"};
+  ASSERT_EQ(s.warnings.size(), std::size(want));
+  for (size_t i = 0; i < std::size(want); ++i)
+    EXPECT_EQ(s.warnings[i], want[i]);
+}
+
 // As Include: relative to the directory of the file that holds the directive.
 TEST(ScenePly, FilenameIsRelativeToTheFileThatNamesIt) {
   fs::path d = temp_dir();

@@ -1295,7 +1295,9 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
     if (ply.skipped_faces > 0)
       warn(loc, fmt::format("{}: {} faces of fewer than 3 vertices ignored", p.what(),
                             ply.skipped_faces));
-    if (ply.indices.empty()) warn(loc, fmt::format("{}: the file has no faces, ignored", p.what()));
+    if (ply.indices.empty())
+      warn(loc,
+           fmt::format("{}: no faces of 3 or more vertices, nothing added, ignored", p.what()));
     m.vertices = std::move(ply.positions);
     m.normals = std::move(ply.normals);
     add_polygons(m, ply.indices, false, gs_.material, emission(), gs_.reverse);
