@@ -9,7 +9,7 @@ packages=(
   pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
   libembree-dev
   libopenimageio-dev openimageio-tools
-  libtinyobjloader-dev nlohmann-json3-dev libcli11-dev libfmt-dev libtbb-dev
+  libtinyobjloader-dev libassimp-dev zlib1g-dev nlohmann-json3-dev libcli11-dev libfmt-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   slurm-wlm munge
 )

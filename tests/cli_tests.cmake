@@ -206,6 +206,14 @@ canopy_cli_test(cli_pbrt_film_output
   "-DARGS=render|${CANOPY_PBRT_DATA}/film_output.pbrt|--quiet"
   "-DFILES=${CMAKE_CURRENT_BINARY_DIR}/pbrt_film_out.png|${CMAKE_CURRENT_BINARY_DIR}/pbrt_film_out.exr"
   -P ${CANOPY_CHECK_CLI})
+# A plymesh scene renders; a truncated PLY file is exit 2 with one line naming it and the
+# directive.
+canopy_cli_test(cli_pbrt_render_plymesh
+  "-DARGS=render|${CANOPY_PBRT_DATA}/ply_scene.pbrt|--spp|1|--quiet|--out|${CANOPY_SCRATCH}/pbrt_ply.exr"
+  "-DNOT_STDERR=warning" "-DFILES=${CANOPY_SCRATCH}/pbrt_ply.exr" -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_pbrt_plymesh_truncated -DSCENE=${CANOPY_PBRT_DATA}/ply_truncated.pbrt
+  "-DEXPECT=${CANOPY_PBRT_DATA}/ply_truncated.pbrt:5: Shape \"plymesh\" \"${CANOPY_PBRT_DATA}/truncated.ply\": truncated: the file ends in vertex 2 of 3 (189 bytes)"
+  -P ${CANOPY_CHECK2})
 # An Include cycle: exit 2, the cycle named.
 canopy_cli_test(cli_pbrt_include_cycle -DSCENE=${CANOPY_PBRT_DATA}/cycle_a.pbrt
   "-DEXPECT=${CANOPY_PBRT_DATA}/cycle_b.pbrt:2: Include cycle: ${CANOPY_PBRT_DATA}/cycle_a.pbrt -> ${CANOPY_PBRT_DATA}/cycle_b.pbrt -> ${CANOPY_PBRT_DATA}/cycle_a.pbrt"

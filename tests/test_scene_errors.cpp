@@ -80,7 +80,7 @@ TEST(SceneErrors, KeyOfAnotherLightType) {
 TEST(SceneErrors, UnknownLightType) {
   EXPECT_EQ(light_error(R"({"type": "laser", "intensity": 1})"),
             "scene.json: lights[0].type: unknown value \"laser\" (expected one of: point, spot, "
-            "sphere, quad, triangle, disk, distant)");
+            "sphere, quad, triangle, disk, distant, environment)");
 }
 
 TEST(SceneErrors, UnknownShapeType) {

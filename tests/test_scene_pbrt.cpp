@@ -436,17 +436,17 @@ TEST(ScenePbrt, EveryUnknownDirectiveOrParameterWarningNamesFileAndLine) {
                  "Camera \"perspective\" \"float fov\" 50 \"float lensradius\" 0.1\n"
                  "Option \"bool wavefront\" true\n"
                  "WorldBegin\n"
-                 "Shape \"plymesh\" \"string filename\" \"a.ply\"\n"
+                 "Shape \"curve\"\n"
                  "LightSource \"goniometric\"\n"
-                 "LightSource \"infinite\"\n"
+                 "LightSource \"projection\"\n"
                  "Shape \"sphere\" \"float radius\" 1 \"float wobble\" 2\n");
   const char* want[] = {"t.pbrt:1: unknown directive 'Frobnicate' ignored",
                         "t.pbrt:2: Camera \"perspective\": \"lensradius\": Canopy's camera is a "
                         "pinhole (no thin lens), ignored",
                         "t.pbrt:3: Option",
-                        "t.pbrt:5: Shape \"plymesh\" is not read in this slice",
+                        "t.pbrt:5: Shape \"curve\" is not read in this slice",
                         "t.pbrt:6: LightSource \"goniometric\" is not read",
-                        "t.pbrt:7: LightSource \"infinite\" is not read",
+                        "t.pbrt:7: LightSource \"projection\" is not read",
                         "t.pbrt:8: Shape \"sphere\": unknown parameter \"float wobble\" ignored"};
   ASSERT_EQ(s.warnings.size(), std::size(want));
   for (size_t i = 0; i < std::size(want); ++i) {
@@ -459,14 +459,15 @@ TEST(ScenePbrt, StrictTurnsAWarningIntoAnError) {
   const std::string text = "WorldBegin\nShape \"sphere\"\nLightSource \"goniometric\"\n";
   EXPECT_EQ(error_of(text), "");
   std::string e = error_of(text, true);
-  EXPECT_EQ(e.rfind("t.pbrt:3: LightSource \"goniometric\" is not read in this slice, ignored", 0), 0u)
+  EXPECT_EQ(e.rfind("t.pbrt:3: LightSource \"goniometric\" is not read in this slice, ignored", 0),
+            0u)
       << e;
   EXPECT_EQ(e.find('\n'), std::string::npos);
 }
 
 TEST(ScenePbrt, ShippedExamplesLoadWithoutWarnings) {
-  for (const auto& f :
-       {std::filesystem::path(CANOPY_SCENES_DIR) / "pbrt" / "cornell.pbrt", kData / "small.pbrt"}) {
+  for (const auto& f : {std::filesystem::path(CANOPY_SCENES_DIR) / "pbrt" / "cornell.pbrt",
+                        kData / "small.pbrt", kData / "ply_scene.pbrt"}) {
     Scene s = load_scene(f, SceneLoadOptions{true});
     EXPECT_GT(s.triangle_count(), 0u) << f;
     EXPECT_FALSE(s.lights.empty()) << f;

@@ -1,15 +1,16 @@
-// pbrt-v4 scene files (https://pbrt.org/fileformat-v4; "the format page" below), first slice:
-// tokenizer, attribute/transform state, Include/Import, object instances (flattened), the
-// perspective camera, film/sampler/integrator settings, triangle/bilinear meshes, spheres and
-// disks, point/spot/diffuse area lights, and diffuse/conductor/coateddiffuse materials. Everything
-// else is skipped with a one-line warning naming file:line (docs/scene-format.md, "pbrt-v4
-// scenes"). The result is the same canopy::Scene the JSON loader builds: geometry goes through
-// Builder::add_mesh (transformed in double, rebased to the camera position, rounded once) and
-// lights through the helpers of lights.cpp.
+// pbrt-v4 scene files (https://pbrt.org/fileformat-v4; "the format page" below): tokenizer,
+// attribute/transform state, Include/Import, object instances (flattened), the perspective camera,
+// film/sampler/integrator settings, triangle/bilinear meshes, PLY meshes (plymesh, read by
+// ply_mesh.cpp), spheres and disks, point/spot/diffuse area lights, and
+// diffuse/conductor/coateddiffuse materials. Everything else is skipped with a one-line warning
+// naming file:line (docs/scene-format.md, "pbrt-v4 scenes"). The result is the same canopy::Scene
+// the JSON loader builds: geometry goes through Builder::add_mesh (transformed in double, rebased
+// to the camera position, rounded once) and lights through the helpers of lights.cpp.
 #include "scene/pbrt_reader.h"
 
 #include "scene/loader_internal.h"
 #include "scene/metal_presets.h"
+#include "scene/ply_mesh.h"
 
 #include <fmt/format.h>
 
@@ -479,7 +480,7 @@ private:
   std::string one_string(const Token& d, Lexer& lx);
   void camera(const Token& d, Params& p, const std::string& type);
   void finish_camera(const Loc& loc);
-  void shape(const Token& d, Params& p, const std::string& type);
+  void shape(const Token& d, Params& p, const std::string& type, const std::filesystem::path& dir);
   void light_source(const Token& d, Params& p, const std::string& type,
                     const std::filesystem::path& base_dir);
   void infinite_light(const Token& d, Params& p, const std::filesystem::path& dir);
@@ -668,6 +669,33 @@ void face_forward_to_normals(Mesh& m) {
       std::swap(m.normal_indices[3 * t + 1], m.normal_indices[3 * t + 2]);
     }
   }
+}
+
+// The triangles of a polygon mesh whose vertices (and vertex normals, if any, one per vertex) are
+// in m: `idx` holds 3 indices a triangle, or with `bilinear` 4 a pbrt-v4 BilinearPatch (p00 p10
+// p01 p11, whose normal cross(p10 - p00, p01 - p00) the triangles (p00 p10 p11) and
+// (p00 p11 p01) keep). Then pbrt-v4's orientation: towards the vertex normals, else the winding
+// (reversed by ReverseOrientation).
+void add_polygons(Mesh& m, const std::vector<uint32_t>& idx, bool bilinear, int32_t material,
+                  float3 emission, bool reverse) {
+  auto add = [&](uint32_t x, uint32_t y, uint32_t z) {
+    m.add_triangle(x, y, z, material, emission);
+    if (!m.normals.empty())
+      m.normal_indices.insert(m.normal_indices.end(), {int32_t(x), int32_t(y), int32_t(z)});
+  };
+  if (!bilinear) {
+    for (size_t t = 0; t + 2 < idx.size(); t += 3)
+      add(idx[t], idx[t + 1], idx[t + 2]);
+  } else {
+    for (size_t t = 0; t + 3 < idx.size(); t += 4) {
+      add(idx[t], idx[t + 1], idx[t + 3]);
+      add(idx[t], idx[t + 3], idx[t + 2]);
+    }
+  }
+  if (!m.normals.empty())
+    face_forward_to_normals(m);
+  else if (reverse)
+    reverse_winding(m);
 }
 
 Mesh sphere_mesh(float radius) {
@@ -1049,7 +1077,7 @@ void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& d
       p.finish();
     } else if (k == "Shape") {
       need_world(true);
-      shape(d, p, type);
+      shape(d, p, type, dir);
     } else if (k == "LightSource") {
       need_world(true);
       light_source(d, p, type, dir);
@@ -1186,7 +1214,9 @@ void Reader::add_mesh(const Loc& loc, Mesh& m, const Transform& ctm) {
 }
 
 // The format page, "Shapes".
-void Reader::shape(const Token& d, Params& p, const std::string& type) {
+// `dir` resolves relative PLY file names (the directory of the file being read).
+void Reader::shape(const Token& d, Params& p, const std::string& type,
+                   const std::filesystem::path& dir) {
   const Loc& loc = d.loc;
   Mesh m;
   bool analytic_light_done = false;
@@ -1254,27 +1284,28 @@ void Reader::shape(const Token& d, Params& p, const std::string& type) {
     std::vector<uint32_t> idx = indices(tri ? 3 : 4, m.vertices.size());
     normals(m.vertices.size());
     p.find("uv"); // texture coordinates: parsed (checked) but unused until textures are read
-    float3 em = emission();
-    auto add = [&](uint32_t x, uint32_t y, uint32_t z) {
-      m.add_triangle(x, y, z, gs_.material, em);
-      if (!m.normals.empty())
-        m.normal_indices.insert(m.normal_indices.end(), {int32_t(x), int32_t(y), int32_t(z)});
-    };
-    if (tri) {
-      for (size_t t = 0; t < idx.size(); t += 3)
-        add(idx[t], idx[t + 1], idx[t + 2]);
-    } else {
-      // pbrt-v4 BilinearPatch: vertices p00, p10, p01, p11; its normal is
-      // cross(p10 - p00, p01 - p00), which the triangles (p00 p10 p11) and (p00 p11 p01) keep.
-      for (size_t t = 0; t < idx.size(); t += 4) {
-        add(idx[t], idx[t + 1], idx[t + 3]);
-        add(idx[t], idx[t + 3], idx[t + 2]);
-      }
-    }
-    if (!m.normals.empty())
-      face_forward_to_normals(m);
-    else if (gs_.reverse)
-      reverse_winding(m);
+    add_polygons(m, idx, !tri, gs_.material, emission(), gs_.reverse);
+  } else if (type == "plymesh") {
+    // pbrt-v4 makes bilinear patches of a PLY file's quads; triangles are the same surface for
+    // planar quads.
+    const std::optional<std::string> f = p.get_string("filename");
+    if (!f) fail(loc, fmt::format("{}: needs \"string filename\"", p.what()));
+    std::filesystem::path file(*f);
+    if (file.is_relative()) file = dir / file; // as Include
+    PlyMesh ply = load_ply_mesh(file, fmt::format("{}:{}: {} \"{}\": ", *loc.file, loc.line,
+                                                  p.what(), file.lexically_normal().string()));
+    if (ply.skipped_faces > 0)
+      warn(loc, fmt::format("{}: {} faces of fewer than 3 vertices ignored", p.what(),
+                            ply.skipped_faces));
+    if (ply.indices.empty())
+      warn(loc,
+           fmt::format("{}: no faces of 3 or more vertices, nothing added, ignored", p.what()));
+    m.vertices = std::move(ply.positions);
+    m.normals = std::move(ply.normals);
+    add_polygons(m, ply.indices, false, gs_.material, emission(), gs_.reverse);
+    // Only used to tessellate for displacement, which is ignored below.
+    if (Param* q = p.one("edgelength", {"float"}))
+      warn(q->loc, fmt::format("{}: \"float edgelength\" ignored", p.what()));
   } else if (type == "sphere" || type == "disk") {
     const bool sph = type == "sphere";
     double radius = p.get_float("radius", 1.0);
@@ -1341,8 +1372,7 @@ void Reader::shape(const Token& d, Params& p, const std::string& type) {
       if (gs_.reverse) reverse_winding(m); // spheres keep their outward shading normals
     }
   } else {
-    warn(loc, fmt::format("Shape \"{}\" is not read in this slice{}, ignored", printable(type),
-                          type == "plymesh" ? " (PLY files come next)" : ""));
+    warn(loc, fmt::format("Shape \"{}\" is not read in this slice, ignored", printable(type)));
     return;
   }
   for (const char* skip : {"alpha", "emissionfilename", "displacement"})

@@ -26,6 +26,7 @@ inline constexpr float kMaxCoordinate = 1e18f;
 inline constexpr uint64_t kMaxSceneFileBytes = uint64_t(256) << 20; // 256 MiB
 inline constexpr uint64_t kMaxObjFileBytes = uint64_t(2) << 30;     // 2 GiB
 inline constexpr uint64_t kMaxMtlFileBytes = uint64_t(64) << 20;    // 64 MiB
+inline constexpr uint64_t kMaxPlyFileBytes = uint64_t(2) << 30;     // 2 GiB, also decompressed
 inline constexpr int kMaxPolygonVertices = 1024;                    // vertices of one OBJ face
 inline constexpr int kMaxSpp = 1 << 24;
 inline constexpr int kMaxFilmSide = 16384;

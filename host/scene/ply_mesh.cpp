@@ -1,0 +1,395 @@
+// PLY meshes via Assimp (Debian's libassimp, 5.2). Assimp 5.2's PLY reader trusts the file: a
+// truncated binary file crashes it (it reads past the end), a truncated ASCII file or header makes
+// it loop forever, and face indices past the vertex count are passed on. So the file's structure
+// is checked first against its header (every element present and complete, list lengths within
+// bounds, ASCII values numeric), and the indices after the import.
+#include "scene/ply_mesh.h"
+
+#include "scene/loader_internal.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstring>
+#include <string_view>
+
+namespace canopy::detail {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& prefix, std::string_view msg) {
+  throw SceneError(fmt::format("{}{}", prefix, msg));
+}
+
+// ------------------------------------------------------------------------------------ gzip
+
+// The gzip members of `in`, decompressed; at most max_bytes.
+std::string gunzip(const std::string& in, uint64_t max_bytes, const std::string& prefix) {
+  if (in.size() < 2 || uint8_t(in[0]) != 0x1f || uint8_t(in[1]) != 0x8b)
+    fail(prefix, "not a gzip file (the name ends in .gz)");
+  z_stream zs{};
+  if (inflateInit2(&zs, 16 + MAX_WBITS) != Z_OK) fail(prefix, "cannot start zlib");
+  struct End {
+    z_stream* zs;
+    ~End() { inflateEnd(zs); }
+  } end{&zs};
+  std::string out;
+  size_t in_pos = 0;
+  int rc = Z_OK;
+  while (true) {
+    if (zs.avail_in == 0 && in_pos < in.size()) {
+      size_t n = std::min<size_t>(in.size() - in_pos, size_t(1) << 30);
+      zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data() + in_pos));
+      zs.avail_in = uInt(n);
+      in_pos += n;
+    }
+    if (out.size() >= max_bytes)
+      fail(prefix, fmt::format("decompressed data is larger than {} bytes", max_bytes));
+    size_t have = out.size();
+    size_t chunk = std::min<size_t>(std::max<size_t>(have, size_t(1) << 16), size_t(1) << 28);
+    out.resize(have + chunk);
+    zs.next_out = reinterpret_cast<Bytef*>(out.data() + have);
+    zs.avail_out = uInt(chunk);
+    rc = inflate(&zs, Z_NO_FLUSH);
+    out.resize(have + (chunk - zs.avail_out));
+    if (rc == Z_STREAM_END) {
+      if (zs.avail_in == 0 && in_pos == in.size()) break;
+      inflateReset(&zs); // another gzip member follows (concatenated .gz files)
+      continue;
+    }
+    if (rc == Z_BUF_ERROR && zs.avail_in == 0 && in_pos == in.size())
+      fail(prefix, "truncated gzip data");
+    if (rc != Z_OK && rc != Z_BUF_ERROR)
+      fail(prefix, fmt::format("corrupt gzip data ({})", zs.msg ? zs.msg : zError(rc)));
+  }
+  if (out.size() > max_bytes)
+    fail(prefix, fmt::format("decompressed data is larger than {} bytes", max_bytes));
+  return out;
+}
+
+// ------------------------------------------------------------------------- structure check
+
+enum class Format { Ascii, BinaryLE, BinaryBE };
+
+struct ScalarType {
+  int size = 0; // bytes in a binary file
+  bool integer = false, is_signed = false;
+};
+
+bool scalar_type(std::string_view name, ScalarType& t) {
+  static const std::pair<std::string_view, ScalarType> types[] = {
+      {"char", {1, true, true}},     {"int8", {1, true, true}},     {"uchar", {1, true, false}},
+      {"uint8", {1, true, false}},   {"short", {2, true, true}},    {"int16", {2, true, true}},
+      {"ushort", {2, true, false}},  {"uint16", {2, true, false}},  {"int", {4, true, true}},
+      {"int32", {4, true, true}},    {"uint", {4, true, false}},    {"uint32", {4, true, false}},
+      {"float", {4, false, true}},   {"float32", {4, false, true}}, {"double", {8, false, true}},
+      {"float64", {8, false, true}},
+  };
+  for (const auto& [n, ty] : types)
+    if (n == name) {
+      t = ty;
+      return true;
+    }
+  return false;
+}
+
+struct Property {
+  std::string name;
+  bool list = false;
+  ScalarType count, item; // count: lists only
+};
+
+struct Element {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<Property> props;
+};
+
+struct Header {
+  Format format = Format::Ascii;
+  std::vector<Element> elements;
+  size_t body = 0; // offset of the first byte after end_header's line
+  // Offsets of the last letter of the vertex properties "texture_s" and "texture_t" (0: absent).
+  size_t texture_s = 0, texture_t = 0;
+};
+
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> out;
+  for (size_t i = 0; i < line.size();) {
+    while (i < line.size() && std::strchr(" \t\r", line[i]))
+      ++i;
+    size_t j = i;
+    while (j < line.size() && !std::strchr(" \t\r", line[j]))
+      ++j;
+    if (j > i) out.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+Header parse_header(const std::string& d, const std::string& prefix) {
+  Header h;
+  size_t pos = 0;
+  int line_no = 0;
+  bool have_format = false;
+  while (true) {
+    size_t eol = d.find('\n', pos);
+    if (eol == std::string::npos)
+      fail(prefix, "not a PLY file or truncated header (no end_header)");
+    std::string_view line(d.data() + pos, eol - pos);
+    pos = eol + 1;
+    ++line_no;
+    auto t = split(line);
+    auto bad = [&](std::string_view what) {
+      fail(prefix, fmt::format("header line {}: {}", line_no, what));
+    };
+    if (line_no == 1) {
+      if (t.size() != 1 || (t[0] != "ply" && t[0] != "PLY"))
+        fail(prefix, "not a PLY file (it does not start with \"ply\")");
+      continue;
+    }
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t[0] == "end_header") break;
+    if (t[0] == "format") {
+      if (t.size() != 3) bad("expected \"format <type> <version>\"");
+      if (t[1] == "ascii")
+        h.format = Format::Ascii;
+      else if (t[1] == "binary_little_endian")
+        h.format = Format::BinaryLE;
+      else if (t[1] == "binary_big_endian")
+        h.format = Format::BinaryBE;
+      else
+        bad(fmt::format("unknown format '{}'", printable(t[1], 40)));
+      have_format = true;
+    } else if (t[0] == "element") {
+      Element e;
+      auto r = t.size() == 3 ? std::from_chars(t[2].data(), t[2].data() + t[2].size(), e.count)
+                             : std::from_chars_result{nullptr, std::errc::invalid_argument};
+      if (r.ec != std::errc() || r.ptr != t[2].data() + t[2].size())
+        bad("expected \"element <name> <count>\"");
+      e.name = t[1];
+      h.elements.push_back(std::move(e));
+    } else if (t[0] == "property") {
+      if (h.elements.empty()) bad("a property before any element");
+      Property p;
+      bool ok;
+      if (t.size() == 5 && t[1] == "list") {
+        p.list = true;
+        ok = scalar_type(t[2], p.count) && p.count.integer && scalar_type(t[3], p.item);
+        p.name = t[4];
+      } else {
+        ok = t.size() == 3 && scalar_type(t[1], p.item);
+        p.name = t.size() == 3 ? t[2] : "";
+      }
+      if (!ok) bad(fmt::format("bad property '{}'", printable(line, 60)));
+      Element& e = h.elements.back();
+      if (e.name == "vertex" && !p.list && (p.name == "texture_s" || p.name == "texture_t"))
+        (p.name == "texture_s" ? h.texture_s : h.texture_t) = size_t(t[2].data() - d.data()) + 8;
+      e.props.push_back(std::move(p));
+    } else {
+      bad(fmt::format("unknown keyword '{}'", printable(t[0], 40)));
+    }
+  }
+  if (!have_format) fail(prefix, "the header has no format line");
+  h.body = pos;
+  return h;
+}
+
+// A list's length limit: faces as for OBJ (Assimp triangulates in quadratic time); other lists
+// are only skipped over.
+uint64_t max_list(const Element& e, const Property& p) {
+  bool face = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+  return face ? uint64_t(kMaxPolygonVertices) : UINT64_MAX;
+}
+
+std::string where(const Element& e, uint64_t i) {
+  return fmt::format("{} {} of {}", printable(e.name, 40), i + 1, e.count);
+}
+
+// The value of a binary integer of type t at p.
+int64_t read_int(const char* p, const ScalarType& t, bool big_endian) {
+  uint64_t u = 0;
+  for (int k = 0; k < t.size; ++k) {
+    int b = big_endian ? k : t.size - 1 - k;
+    u = (u << 8) | uint8_t(p[b]);
+  }
+  if (t.is_signed && t.size < 8 && (u >> (8 * t.size - 1)) & 1u) u |= ~uint64_t(0) << (8 * t.size);
+  return int64_t(u);
+}
+
+void check_binary(const std::string& d, const Header& h, const std::string& prefix) {
+  const bool be = h.format == Format::BinaryBE;
+  size_t pos = h.body;
+  auto truncated = [&](const Element& e, uint64_t i) {
+    fail(prefix, fmt::format("truncated: the file ends in {} ({} bytes)", where(e, i), d.size()));
+  };
+  for (const Element& e : h.elements) {
+    bool fixed = std::none_of(e.props.begin(), e.props.end(), [](auto& p) { return p.list; });
+    if (fixed) {
+      uint64_t row = 0;
+      for (const Property& p : e.props)
+        row += uint64_t(p.item.size);
+      if (row == 0) continue;
+      uint64_t rows = (d.size() - pos) / row;
+      if (rows < e.count) truncated(e, rows);
+      pos += size_t(e.count * row);
+      continue;
+    }
+    for (uint64_t i = 0; i < e.count; ++i)
+      for (const Property& p : e.props) {
+        uint64_t n = 1;
+        if (p.list) {
+          if (d.size() - pos < size_t(p.count.size)) truncated(e, i);
+          int64_t c = read_int(d.data() + pos, p.count, be);
+          pos += size_t(p.count.size);
+          if (c < 0 || uint64_t(c) > max_list(e, p))
+            fail(prefix, fmt::format("{}: list \"{}\" has {} entries", where(e, i),
+                                     printable(p.name, 40), c));
+          n = uint64_t(c);
+        }
+        if (n > (d.size() - pos) / uint64_t(p.item.size)) truncated(e, i);
+        pos += size_t(n * uint64_t(p.item.size));
+      }
+  }
+}
+
+bool numeric(std::string_view tok, bool integer, int64_t* value = nullptr) {
+  if (tok.size() > 1 && tok[0] == '+') tok.remove_prefix(1); // Assimp accepts it; from_chars not
+  const char* end = tok.data() + tok.size();
+  if (integer) {
+    int64_t v = 0;
+    auto r = std::from_chars(tok.data(), end, v);
+    if (value) *value = v;
+    return r.ec == std::errc() && r.ptr == end;
+  }
+  double v = 0;
+  auto r = std::from_chars(tok.data(), end, v);
+  return r.ptr == end && (r.ec == std::errc() || r.ec == std::errc::result_out_of_range);
+}
+
+// One element instance per line (blank lines are skipped, as Assimp does); values past the
+// element's properties are ignored, as Assimp does.
+void check_ascii(const std::string& d, const Header& h, const std::string& prefix) {
+  size_t pos = h.body;
+  int line_no = int(std::count(d.begin(), d.begin() + ptrdiff_t(h.body), '\n'));
+  for (const Element& e : h.elements)
+    for (uint64_t i = 0; i < e.count; ++i) {
+      std::vector<std::string_view> t;
+      while (t.empty()) {
+        if (pos >= d.size())
+          fail(prefix,
+               fmt::format("truncated: the file ends in {} (line {})", where(e, i), line_no + 1));
+        size_t eol = std::min(d.find('\n', pos), d.size());
+        t = split(std::string_view(d.data() + pos, eol - pos));
+        pos = eol + 1;
+        ++line_no;
+      }
+      size_t k = 0;
+      auto bad = [&](std::string_view what) {
+        fail(prefix, fmt::format("line {}: {}: {}", line_no, where(e, i), what));
+      };
+      for (const Property& p : e.props) {
+        uint64_t n = 1;
+        if (p.list) {
+          int64_t c = 0;
+          if (k >= t.size()) bad("too few values");
+          if (!numeric(t[k++], true, &c) || c < 0 || uint64_t(c) > max_list(e, p))
+            bad(fmt::format("list \"{}\" has the length '{}'", printable(p.name, 40),
+                            printable(t[k - 1], 40)));
+          n = uint64_t(c);
+        }
+        if (n > t.size() - k) bad("too few values");
+        for (uint64_t j = 0; j < n; ++j, ++k)
+          if (!numeric(t[k], p.item.integer))
+            bad(fmt::format("'{}' is not a{} number", printable(t[k], 40),
+                            p.item.integer ? "n integer" : ""));
+      }
+    }
+}
+
+// Assimp reads uv named "u"/"v", "s"/"t" and "texture_u"/"texture_v" but not pbrt-v4's fourth
+// spelling "texture_s"/"texture_t": those names are changed to "texture_u"/"texture_v" in the
+// header (the same length, so the body stays where it is).
+void rename_texture_st(std::string& d, const Header& h) {
+  if (!h.texture_s || !h.texture_t) return;
+  d[h.texture_s] = 'u';
+  d[h.texture_t] = 'v';
+}
+
+std::string one_line(std::string s) {
+  std::replace_if(
+      s.begin(), s.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+  while (!s.empty() && s.back() == ' ')
+    s.pop_back();
+  return s;
+}
+
+} // namespace
+
+PlyMesh load_ply_mesh(const std::filesystem::path& file, const std::string& prefix) {
+  std::string data = read_input_file(file, kMaxPlyFileBytes, prefix);
+  if (file.extension() == ".gz") data = gunzip(data, kMaxPlyFileBytes, prefix);
+  const Header h = parse_header(data, prefix);
+  if (h.format == Format::Ascii)
+    check_ascii(data, h, prefix);
+  else
+    check_binary(data, h, prefix);
+
+  PlyMesh out;
+  uint64_t vertices = 0, faces = 0;
+  for (const Element& e : h.elements) {
+    if (e.name == "vertex") vertices = e.count;
+    if (e.name == "face") faces = e.count;
+  }
+  // Assimp makes a point cloud of a file without faces; there is nothing to render in it.
+  if (vertices == 0 || faces == 0) return out;
+  rename_texture_st(data, h);
+
+  Assimp::Importer importer;
+  // Triangulation only: no welding (aiProcess_JoinIdenticalVertices), no generated normals, no
+  // validation pass that would drop or reorder data.
+  const aiScene* scene =
+      importer.ReadFileFromMemory(data.data(), data.size(), aiProcess_Triangulate, "ply");
+  if (!scene) fail(prefix, fmt::format("not read: {}", one_line(importer.GetErrorString())));
+  if (scene->mNumMeshes != 1)
+    fail(prefix, fmt::format("not read: Assimp made {} meshes of it", scene->mNumMeshes));
+  const aiMesh& m = *scene->mMeshes[0];
+  if (m.mNumVertices != vertices)
+    fail(prefix,
+         fmt::format("not read: Assimp read {} of its {} vertices", m.mNumVertices, vertices));
+  out.positions.resize(m.mNumVertices);
+  for (unsigned v = 0; v < m.mNumVertices; ++v)
+    out.positions[v] = make_float3(m.mVertices[v].x, m.mVertices[v].y, m.mVertices[v].z);
+  if (m.HasNormals()) {
+    out.normals.resize(m.mNumVertices);
+    for (unsigned v = 0; v < m.mNumVertices; ++v)
+      out.normals[v] = make_float3(m.mNormals[v].x, m.mNormals[v].y, m.mNormals[v].z);
+  }
+  if (m.HasTextureCoords(0) && m.mNumUVComponents[0] >= 2) {
+    out.uv.resize(m.mNumVertices);
+    for (unsigned v = 0; v < m.mNumVertices; ++v)
+      out.uv[v] = make_float2(m.mTextureCoords[0][v].x, m.mTextureCoords[0][v].y);
+  }
+  out.indices.reserve(size_t(m.mNumFaces) * 3);
+  for (unsigned f = 0; f < m.mNumFaces; ++f) {
+    const aiFace& face = m.mFaces[f];
+    if (face.mNumIndices < 3) {
+      ++out.skipped_faces;
+      continue;
+    }
+    if (face.mNumIndices > 3) fail(prefix, "not read: Assimp left a polygon untriangulated");
+    for (unsigned k = 0; k < 3; ++k)
+      if (face.mIndices[k] >= m.mNumVertices)
+        fail(prefix, fmt::format("a face has the vertex index {}, out of range [0, {})",
+                                 int32_t(face.mIndices[k]), m.mNumVertices));
+    out.indices.insert(out.indices.end(), face.mIndices, face.mIndices + 3);
+  }
+  return out;
+}
+
+} // namespace canopy::detail
