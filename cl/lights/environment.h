@@ -101,7 +101,8 @@ INLINE uint env_texel_of(const GLOBAL Light* l, float3 m) {
 INLINE float env_map_pdf(const GLOBAL Light* l, float pmf, float3 m) {
   float n = (float)env_width(l) * (float)env_height(l);
   if (l->flags == ENV_OCTAHEDRAL) return pmf * n * (0.25f / CANOPY_PI);
-  float st = sqrt(fmax(0.0f, 1.0f - m.z * m.z));
+  // sin(theta) from x and y: 1 - z^2 would round to 0 within 3e-4 rad of the poles
+  float st = sqrt(m.x * m.x + m.y * m.y);
   return st > 0.0f ? pmf * n / (2.0f * CANOPY_PI * CANOPY_PI * st) : 0.0f;
 }
 
@@ -144,7 +145,11 @@ INLINE float3 env_sample(const GLOBAL Light* l, const EnvBuffers* eb, float3 N, 
     uint k = (uint)lt_alias_pick(eb->alias_prob + first, eb->alias_index + first, wd * ht, rng);
     float2 uv = make_float2(((float)(k % wd) + u1) / (float)wd, ((float)(k / wd) + u2) / (float)ht);
     float3 m = l->flags == ENV_EQUIRECT ? env_equirect_dir(uv) : env_octahedral_dir(uv);
-    w = normalize(env_from_map(l, m));
+    // The drawn texel's own density and radiance (a lookup of the rounded direction could land
+    // in a neighbour at a patch's edge): exactly the procedure's density.
+    *pdf = env_map_pdf(l, eb->pmf[first + k], m);
+    *L = xyz_of(l->emission) * xyz_of(eb->texels[first + k]);
+    return normalize(env_from_map(l, m));
   }
   *pdf = env_pdf(l, eb, N, w);
   *L = env_radiance(l, eb, w);
