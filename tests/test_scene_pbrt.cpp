@@ -467,6 +467,7 @@ TEST(ScenePbrt, StrictTurnsAWarningIntoAnError) {
 
 TEST(ScenePbrt, ShippedExamplesLoadWithoutWarnings) {
   for (const auto& f : {std::filesystem::path(CANOPY_SCENES_DIR) / "pbrt" / "cornell.pbrt",
+                        std::filesystem::path(CANOPY_SCENES_DIR) / "pbrt" / "outdoor.pbrt",
                         kData / "small.pbrt", kData / "ply_scene.pbrt"}) {
     Scene s = load_scene(f, SceneLoadOptions{true});
     EXPECT_GT(s.triangle_count(), 0u) << f;
