@@ -66,12 +66,13 @@ TEST_P(RenderFeatures, MinimalFeatureSetRendersTheSameImageAsEveryFeature) {
   // no disk code for a scene without disks
   EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_DISK=0"), std::string::npos) << minimal_opts;
   EXPECT_NE(minimal_opts.find("-DHAS_PRIM_DISK=0"), std::string::npos) << minimal_opts;
-  EXPECT_NE(all_opts.find("-DHAS_LIGHT_DISK=1 -DHAS_LIGHT_DISTANT=1 -DHAS_PRIM_SPHERE=1 "
-                          "-DHAS_PRIM_DISK=1"),
+  EXPECT_NE(all_opts.find("-DHAS_LIGHT_DISK=1 -DHAS_LIGHT_DISTANT=1 -DHAS_LIGHT_ENVIRONMENT=1 "
+                          "-DHAS_PRIM_SPHERE=1 -DHAS_PRIM_DISK=1"),
             std::string::npos)
       << all_opts;
-  // nor distant-light code without a distant light
-  EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_DISTANT=0"), std::string::npos) << minimal_opts;
+  // nor distant- or environment-light code without such a light
+  EXPECT_NE(minimal_opts.find("-DHAS_LIGHT_DISTANT=0 -DHAS_LIGHT_ENVIRONMENT=0"), std::string::npos)
+      << minimal_opts;
   // a diffuse-only scene compiles no GGX or Fresnel code (cl/bsdf/bsdf.h)
   EXPECT_NE(minimal_opts.find("-DHAS_MATERIAL_CONDUCTOR=0 -DHAS_MATERIAL_PLASTIC=0"),
             std::string::npos)
