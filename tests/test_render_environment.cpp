@@ -402,3 +402,57 @@ TEST(EnvironmentScene, JsonAndPbrt) {
     EXPECT_NE(std::string(e.what()).find("no such file"), std::string::npos) << e.what();
   }
 }
+
+// The sky and a light of the tree together at glossy points: a point light above the gold plane
+// adds f(wo, wi) cos(theta) I / d^2 (exact at each pixel's centre; the narrow field keeps it
+// nearly constant over the footprint) to the sky's L times the albedo. Checks that the sky's
+// escaped rays and light samples keep their weights beside the tree's techniques (brdf-mis'
+// three at glossy points).
+TEST(EnvironmentRender, SkyAndATreeLightAddUpAtGlossyPoints) {
+  MaterialDesc gold = conductor_material("gold", 0.4f, make_float3(0.143f, 0.374f, 1.442f),
+                                         make_float3(3.983f, 2.385f, 1.603f));
+  const float L = 0.8f, I = 6.0f;
+  const float3 pl = make_float3(0.6f, 0.3f, 2.0f);
+  Scene probe = plane_under_sky(gold);
+  float3 wo0 = normalize(probe.camera.position - probe.camera.look_at);
+  Material m = gold.gpu;
+  double a = 0.0, a2 = 0.0;
+  std::mt19937 gen(2);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const int n = 1000000;
+  for (int i = 0; i < n; ++i) {
+    BsdfSample bs = bsdf_sample(&m, wo0, make_float3(u(gen), u(gen), u(gen)));
+    double x = bs.pdf > 0.0f && bs.wi.z > 0.0f ? double(bs.weight.x) : 0.0;
+    a += x;
+    a2 += x * x;
+  }
+  const double albedo = a / n, albedo_se = std::sqrt(std::max(0.0, a2 / n - albedo * albedo) / n);
+  CameraParams cam = make_camera_params(probe.camera, probe.film.width, probe.film.height);
+  double point_term = 0.0; // image mean of the point light's exact radiance at pixel centres
+  for (int y = 0; y < probe.film.height; ++y)
+    for (int x = 0; x < probe.film.width; ++x) {
+      float3 d = normalize(xyz_of(cam.lower_left) + xyz_of(cam.du) * (float(x) + 0.5f) +
+                           xyz_of(cam.dv) * (float(y) + 0.5f));
+      float3 o = xyz_of(cam.origin);
+      float3 X = o + d * (-o.z / d.z);
+      float3 to = pl - X;
+      float d2 = dot(to, to);
+      float3 wi = to * (1.0f / std::sqrt(d2));
+      point_term += double(bsdf_eval(&m, d * -1.0f, wi).x) * wi.z * I / d2;
+    }
+  point_term /= double(probe.film.width * probe.film.height);
+  const double expect = L * albedo + point_term;
+  for (const char* sampler : {"tree", "tree-split", "brdf-mis", "brdf-oriented"}) {
+    Scene scene = plane_under_sky(gold);
+    scene.infinite_lights.push_back(env_light(make_float3(L, L, L), -1));
+    Light point{};
+    point.type = LIGHT_POINT;
+    point.p = f4_from3(pl, 0.0f);
+    point.emission = make_float4(I, I, I, 0.0f);
+    point.prim = -1;
+    scene.lights.push_back(point);
+    Film film = render(scene, sampler, 64);
+    auto [mean, se] = image_mean(film);
+    EXPECT_NEAR(mean, expect, 5.0 * (se + L * albedo_se) + 0.005 * expect) << sampler;
+  }
+}
