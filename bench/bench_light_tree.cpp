@@ -290,7 +290,8 @@ void BM_DevicePick(benchmark::State& state) {
   args.set("N", upload_buffer(ctx, N));
   args.set("count", cl_int(kPicks));
   args.set("out", cl::Buffer(ctx, CL_MEM_WRITE_ONLY, sizeof(int) * kPicks));
-  // The BRDF-oriented cut's per-path scratch (LIGHT_SAMPLER_PARAMS); the tree samplers never read it.
+  // The BRDF-oriented cut's per-path scratch (LIGHT_SAMPLER_PARAMS); the tree samplers never read
+  // it.
   args.set("brdf_cut", cl::Buffer(ctx, CL_MEM_READ_WRITE, sizeof(cl_float2)));
   BoundKernel k(program, "pick_bench", args);
   // Warm-up (and PoCL's work-group compile).

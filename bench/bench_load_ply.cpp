@@ -11,6 +11,8 @@
 #include "render/light_sampler_data.h"
 #include "scene/scene.h"
 
+#include "temp_dir.h"
+
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
@@ -30,22 +32,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path dir;
-  TempDir() {
-    dir = fs::temp_directory_path() / fmt::format("canopy-bench-ply-{}", ::getpid());
-    fs::create_directories(dir);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-};
-
 // A wavy grid of about `triangles` triangles (2 per cell) as a binary little-endian PLY, and a
 // pbrt file that loads it (emissive or not).
 fs::path scene_file(int triangles, bool emissive) {
-  static TempDir tmp;
+  static bench::TempDir tmp("ply");
   static std::map<std::pair<int, bool>, fs::path> files;
   auto key = std::make_pair(triangles, emissive);
   if (auto it = files.find(key); it != files.end()) return it->second;
@@ -82,8 +72,9 @@ fs::path scene_file(int triangles, bool emissive) {
   const fs::path pbrt = tmp.dir / fmt::format("grid-{}-{}.pbrt", triangles, int(emissive));
   std::FILE* f = std::fopen(pbrt.c_str(), "w");
   if (!f) throw std::runtime_error("cannot write " + pbrt.string());
-  fmt::print(f, "LookAt 0.5 0.5 2  0.5 0.5 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n{}"
-                "Shape \"plymesh\" \"string filename\" \"{}\"\n",
+  fmt::print(f,
+             "LookAt 0.5 0.5 2  0.5 0.5 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n{}"
+             "Shape \"plymesh\" \"string filename\" \"{}\"\n",
              emissive ? "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n" : "",
              ply.filename().string());
   std::fclose(f);

@@ -10,6 +10,8 @@
 // time) and removed at exit.
 #include "scene/scene.h"
 
+#include "temp_dir.h"
+
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
@@ -29,19 +31,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Deletes the generated files when the process ends.
-struct TempDir {
-  fs::path dir;
-  TempDir() {
-    dir = fs::temp_directory_path() / fmt::format("canopy-bench-load-{}", ::getpid());
-    fs::create_directories(dir);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-};
-
 // A small LCG: the bench only needs reproducible, spread-out positions.
 struct Lcg {
   uint64_t s;
@@ -52,7 +41,7 @@ struct Lcg {
 };
 
 const fs::path& scene_file(int n) {
-  static TempDir tmp;
+  static bench::TempDir tmp("load");
   static std::map<int, fs::path> files;
   auto it = files.find(n);
   if (it != files.end()) return it->second;

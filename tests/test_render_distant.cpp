@@ -9,6 +9,7 @@
 #include "render/renderer.h"
 #include "scene/pbrt_reader.h"
 #include "scene/scene.h"
+#include "support/lit_plane.h"
 
 #include <gtest/gtest.h>
 
@@ -31,37 +32,12 @@ Light distant_light(float3 travel, float3 E) {
 
 // A 100 x 100 plane at z = 0 seen from above; `fov` degrees.
 Scene plane_scene(MaterialDesc m, float fov) {
-  Scene s;
-  s.path = "distant-plane";
-  s.camera.position = make_float3(0.4f, -0.3f, 5.0f);
-  s.camera.look_at = make_float3(0.0f, 0.0f, 0.0f);
-  s.camera.up = make_float3(0.0f, 1.0f, 0.0f);
-  s.camera.fov_y_deg = fov;
-  s.film.width = 24;
-  s.film.height = 20;
-  s.integrator.max_depth = 1;
-  s.materials.push_back(std::move(m));
-  const float e = 50.0f;
-  s.vertices = {make_float3(-e, -e, 0), make_float3(e, -e, 0), make_float3(e, e, 0),
-                make_float3(-e, e, 0)};
-  s.indices = {0, 1, 2, 0, 2, 3};
-  s.triangle_material = {0, 0};
-  s.triangle_light = {-1, -1};
-  return s;
+  return test::lit_plane_scene(std::move(m), fov, 50.0f, 24, 20);
 }
 
 Film render(Scene& scene, const std::string& sampler, int spp, int max_depth = 1) {
   scene.integrator.max_depth = max_depth;
-  ClRuntime rt;
-  RendererOptions opt;
-  opt.light_sampler = sampler;
-  Renderer renderer(rt, scene, opt);
-  RenderSettings rs;
-  rs.spp = spp;
-  rs.seed = 5;
-  Film film = renderer.render(rs);
-  EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
-  return film;
+  return test::render_lit_plane(scene, sampler, spp);
 }
 
 const char* const kSamplers[] = {"uniform",    "power",    "tree",         "tree-split",

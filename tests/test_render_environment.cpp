@@ -11,6 +11,7 @@
 #include "render/renderer.h"
 #include "scene/pbrt_reader.h"
 #include "scene/scene.h"
+#include "support/lit_plane.h"
 
 #include <gtest/gtest.h>
 
@@ -203,38 +204,13 @@ TEST(EnvironmentSampling, BadMapsAreOneLineErrors) {
 
 namespace {
 
+// Every pixel sees the plane (a narrow field), wide enough to hide the lower hemisphere.
 Scene plane_under_sky(MaterialDesc m) {
-  Scene s;
-  s.path = "sky-plane";
-  s.camera.position = make_float3(0.3f, -0.2f, 5.0f);
-  s.camera.look_at = make_float3(0.0f, 0.0f, 0.0f);
-  s.camera.up = make_float3(0.0f, 1.0f, 0.0f);
-  s.camera.fov_y_deg = 10.0f; // every pixel sees the plane
-  s.film.width = 16;
-  s.film.height = 12;
-  s.integrator.max_depth = 1;
-  s.materials.push_back(std::move(m));
-  const float e = 1e3f; // wide enough that the plane hides the lower hemisphere
-  s.vertices = {make_float3(-e, -e, 0), make_float3(e, -e, 0), make_float3(e, e, 0),
-                make_float3(-e, e, 0)};
-  s.indices = {0, 1, 2, 0, 2, 3};
-  s.triangle_material = {0, 0};
-  s.triangle_light = {-1, -1};
-  return s;
+  return test::lit_plane_scene(std::move(m), 10.0f, 1e3f, 16, 12);
 }
 
 Film render(Scene& scene, const std::string& sampler, int spp, bool mis = true) {
-  ClRuntime rt;
-  RendererOptions opt;
-  opt.light_sampler = sampler;
-  opt.mis = mis;
-  Renderer renderer(rt, scene, opt);
-  RenderSettings rs;
-  rs.spp = spp;
-  rs.seed = 3;
-  Film film = renderer.render(rs);
-  EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
-  return film;
+  return test::render_lit_plane(scene, sampler, spp, mis);
 }
 
 // Image mean of channel 0 and its standard error (pixels as independent estimates).
@@ -281,18 +257,8 @@ TEST(EnvironmentRender, ConstantSkyOnAGlossyPlaneIsLTimesTheAlbedo) {
   const float L = 1.5f;
   Scene probe = plane_under_sky(gold);
   float3 wo = normalize(probe.camera.position - probe.camera.look_at);
-  Material m = gold.gpu;
-  double a = 0.0, a2 = 0.0;
-  std::mt19937 gen(1);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  const int n = 1000000;
-  for (int i = 0; i < n; ++i) {
-    BsdfSample bs = bsdf_sample(&m, wo, make_float3(u(gen), u(gen), u(gen)));
-    double x = bs.pdf > 0.0f && bs.wi.z > 0.0f ? double(bs.weight.x) : 0.0;
-    a += x;
-    a2 += x * x;
-  }
-  double albedo = a / n, albedo_se = std::sqrt(std::max(0.0, a2 / n - albedo * albedo) / n);
+  double albedo_se;
+  const double albedo = test::directional_albedo(gold.gpu, wo, 1000000, 1u, &albedo_se);
   for (const char* sampler : {"tree", "power", "brdf-mis", "brdf-oriented", "bsdf"}) {
     Scene scene = plane_under_sky(gold);
     scene.infinite_lights.push_back(env_light(make_float3(L, L, L), -1));
@@ -415,18 +381,9 @@ TEST(EnvironmentRender, SkyAndATreeLightAddUpAtGlossyPoints) {
   const float3 pl = make_float3(0.6f, 0.3f, 2.0f);
   Scene probe = plane_under_sky(gold);
   float3 wo0 = normalize(probe.camera.position - probe.camera.look_at);
-  Material m = gold.gpu;
-  double a = 0.0, a2 = 0.0;
-  std::mt19937 gen(2);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  const int n = 1000000;
-  for (int i = 0; i < n; ++i) {
-    BsdfSample bs = bsdf_sample(&m, wo0, make_float3(u(gen), u(gen), u(gen)));
-    double x = bs.pdf > 0.0f && bs.wi.z > 0.0f ? double(bs.weight.x) : 0.0;
-    a += x;
-    a2 += x * x;
-  }
-  const double albedo = a / n, albedo_se = std::sqrt(std::max(0.0, a2 / n - albedo * albedo) / n);
+  const Material m = gold.gpu;
+  double albedo_se;
+  const double albedo = test::directional_albedo(m, wo0, 1000000, 2u, &albedo_se);
   CameraParams cam = make_camera_params(probe.camera, probe.film.width, probe.film.height);
   double point_term = 0.0; // image mean of the point light's exact radiance at pixel centres
   for (int y = 0; y < probe.film.height; ++y)

@@ -1,0 +1,72 @@
+// A plane at z = 0 seen from above, with nothing else in the scene (lights are the caller's), and
+// a render of it: the fixture of the closed-form tests of lights at infinity
+// (test_render_distant.cpp, test_render_environment.cpp).
+#pragma once
+
+#include "bsdf/bsdf.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace canopy::test {
+
+// A (2 half) x (2 half) square of material m at z = 0, the camera at (0.3, -0.2, 5) looking at the
+// origin with a vertical field of fov degrees, a width x height film, direct light (max_depth 1).
+inline Scene lit_plane_scene(MaterialDesc m, float fov, float half, int width, int height) {
+  Scene s;
+  s.path = "lit-plane";
+  s.camera.position = make_float3(0.3f, -0.2f, 5.0f);
+  s.camera.look_at = make_float3(0.0f, 0.0f, 0.0f);
+  s.camera.up = make_float3(0.0f, 1.0f, 0.0f);
+  s.camera.fov_y_deg = fov;
+  s.film.width = width;
+  s.film.height = height;
+  s.integrator.max_depth = 1;
+  s.materials.push_back(std::move(m));
+  s.vertices = {make_float3(-half, -half, 0), make_float3(half, -half, 0),
+                make_float3(half, half, 0), make_float3(-half, half, 0)};
+  s.indices = {0, 1, 2, 0, 2, 3};
+  s.triangle_material = {0, 0};
+  s.triangle_light = {-1, -1};
+  return s;
+}
+
+// Renders `scene` with `sampler` at spp (seed 5); no sample may be non-finite.
+inline Film render_lit_plane(Scene& scene, const std::string& sampler, int spp, bool mis = true) {
+  ClRuntime rt;
+  RendererOptions opt;
+  opt.light_sampler = sampler;
+  opt.mis = mis;
+  Renderer renderer(rt, scene, opt);
+  RenderSettings rs;
+  rs.spp = spp;
+  rs.seed = 5;
+  Film film = renderer.render(rs);
+  EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
+  return film;
+}
+
+// The red channel of the directional albedo of m at wo (local frame, z up), integral of
+// f cos over the hemisphere, estimated from n of the kernels' own BSDF samples; *se: its
+// standard error.
+inline double directional_albedo(const Material& m, float3 wo, int n, unsigned seed, double* se) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  double a = 0.0, a2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    BsdfSample bs = bsdf_sample(&m, wo, make_float3(u(gen), u(gen), u(gen)));
+    double x = bs.pdf > 0.0f && bs.wi.z > 0.0f ? double(bs.weight.x) : 0.0;
+    a += x;
+    a2 += x * x;
+  }
+  double mean = a / n;
+  *se = std::sqrt(std::max(0.0, a2 / n - mean * mean) / n);
+  return mean;
+}
+
+} // namespace canopy::test
