@@ -1433,24 +1433,21 @@ void Reader::light_source(const Token& d, Params& p, const std::string& type,
   l.p = f4_from3(rebase(xf.apply(from), scene_.origin), 0.0f);
   if (type == "point") {
     l.type = LIGHT_POINT;
-  } else if (distant) {
-    // Light travels from "from" to "to" (pbrt-v4 DistantLight): e1 points back, towards it.
-    l.type = LIGHT_DISTANT;
-    l.p = make_float4(0, 0, 0, 0);
-    double3 to = p.get_point("to").value_or(double3{0, 0, 1});
-    double3 dir = linear(xf, from - to);
-    double dl = len3(dir);
-    if (!(dl > 0.0) || !std::isfinite(dl))
-      fail(d.loc, fmt::format("{}: \"from\" and \"to\" must differ", p.what()));
-    l.e1 = f4_from3(to_float3(dir * (1.0 / dl)), 0.0f);
   } else {
-    l.type = LIGHT_SPOT;
+    // The unit world direction from "from" to "to" (default (0 0 1)): a spot's axis; a distant
+    // light's travel (pbrt-v4 DistantLight), whose e1 points back, towards the light.
     double3 to = p.get_point("to").value_or(double3{0, 0, 1});
     double3 dir = linear(xf, to - from);
     double dl = len3(dir);
     if (!(dl > 0.0) || !std::isfinite(dl))
       fail(d.loc, fmt::format("{}: \"from\" and \"to\" must differ", p.what()));
-    l.e1 = f4_from3(to_float3(dir * (1.0 / dl)), 0.0f);
+    l.e1 = f4_from3(to_float3(dir * ((distant ? -1.0 : 1.0) / dl)), 0.0f);
+  }
+  if (distant) {
+    l.type = LIGHT_DISTANT;
+    l.p = make_float4(0, 0, 0, 0);
+  } else if (type == "spot") {
+    l.type = LIGHT_SPOT;
     // pbrt-v4 SpotLight: full intensity inside coneangle - conedelta, a smoothstep in cos theta
     // out to coneangle; Canopy's spot (cl/lights/light_sample.h spot_falloff) is the same
     // smoothstep between its falloff start and its cone edge.
