@@ -13,6 +13,7 @@
 #include "scene/scene.h"
 #include "support/lit_plane.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -271,19 +272,21 @@ TEST(EnvironmentRender, ConstantSkyOnAGlossyPlaneIsLTimesTheAlbedo) {
 
 // A map that is black but for one texel: the plane's radiance is rho / pi times that texel's
 // irradiance, the integral of L cos(theta) over its patch (a 64 x 64 midpoint rule, far finer than
-// the patch's curvature). Every light sample lands in the texel; BSDF rays find it rarely.
+// the patch's curvature). Every light sample lands in the texel; BSDF rays find it rarely. At
+// 10^38 and 10^-36 (near float's limits) too: the renderer's emission scale must take the map's
+// brightest texel into account, not only the light's scale.
 TEST(EnvironmentRender, OneBrightTexelIsItsIrradiance) {
-  for (int projection : {ENV_EQUIRECT, ENV_OCTAHEDRAL}) {
+  for (auto [projection, Lt] : {std::pair{ENV_EQUIRECT, 50.0f}, std::pair{ENV_OCTAHEDRAL, 50.0f},
+                                std::pair{ENV_EQUIRECT, 1e38f}, std::pair{ENV_EQUIRECT, 1e-36f}}) {
     const int w = 16, h = projection == ENV_OCTAHEDRAL ? 16 : 8;
     const int ti = 5, tj = projection == ENV_OCTAHEDRAL ? 7 : 2; // a texel above the horizon
     std::vector<float> rgb(size_t(w * h * 3), 0.0f);
-    const float Lt = 50.0f;
     for (int k = 0; k < 3; ++k)
       rgb[(size_t(tj) * size_t(w) + size_t(ti)) * 3 + size_t(k)] = Lt;
     Scene scene = plane_under_sky(diffuse_material("white", make_float3(0.5f, 0.5f, 0.5f)));
     Light l = env_light(make_float3(1, 1, 1), 0);
     scene.environment_maps.push_back(
-        {write_map(projection == ENV_OCTAHEDRAL ? "oct.exr" : "eq.exr", w, h, rgb), projection});
+        {write_map(fmt::format("map-{}-{}.exr", projection, Lt), w, h, rgb), projection});
     scene.infinite_lights.push_back(l);
     double E = 0.0;
     const int q = 64;
@@ -304,7 +307,7 @@ TEST(EnvironmentRender, OneBrightTexelIsItsIrradiance) {
       Film film = render(s, sampler, std::string(sampler) == "bsdf" ? 256 : 16);
       auto [mean, se] = image_mean(film);
       EXPECT_NEAR(mean, expect, 5.0 * se + 1e-4 * expect)
-          << sampler << ", projection " << projection;
+          << sampler << ", projection " << projection << ", texel " << Lt;
     }
   }
 }

@@ -142,15 +142,26 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
 
   t0 = Clock::now();
   const cl::Context& ctx = rt.context();
-  // The exponent of the brightest emission of either list (0 for an empty list: not a candidate).
-  stats_.emission_exponent = scene.infinite_lights.empty() ? emission_scale_exponent(scene.lights)
-                             : scene.lights.empty()
-                                 ? emission_scale_exponent(scene.infinite_lights)
-                                 : std::max(emission_scale_exponent(scene.lights),
-                                            emission_scale_exponent(scene.infinite_lights));
   // Environment maps are read here (not by the scene loader): the texels go to the device only.
   std::vector<Light> infinite = scene.infinite_lights;
   EnvironmentData environment = build_environment_data(infinite, scene.environment_maps);
+  // The exponent of the brightest emission of either list (0 for an empty list: not a candidate);
+  // a map's radiance is its scale times its brightest texel.
+  std::vector<Light> brightest = infinite;
+  for (Light& l : brightest) {
+    if (l.type != LIGHT_ENVIRONMENT || l.flags == ENV_CONSTANT) continue;
+    float m = 0.0f;
+    for (uint32_t k = 0, first = float_as_uint_(l.p.x),
+                  n = float_as_uint_(l.p.y) * float_as_uint_(l.p.z);
+         k < n; ++k)
+      m = std::max(m, max3(xyz_of(environment.texels[first + k])));
+    l.emission = l.emission * m;
+  }
+  stats_.emission_exponent =
+      brightest.empty() ? emission_scale_exponent(scene.lights)
+      : scene.lights.empty()
+          ? emission_scale_exponent(brightest)
+          : std::max(emission_scale_exponent(scene.lights), emission_scale_exponent(brightest));
   device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
                                 stats_.emission_exponent, scene.medium, infinite, environment);
   std::vector<CameraParams> cam = {
