@@ -401,8 +401,9 @@ int run_render(const RenderArgs& args) {
     write_png(args.emitter_mask, mask_to_image(film.emitter_mask(), film.width, film.height));
   const RenderStats& st = renderer.stats();
   std::string skipped =
-      (scene.infinite_lights.empty() ? std::string()
-                                    : fmt::format(" and {} distant", scene.infinite_lights.size())) +
+      (scene.infinite_lights.empty()
+           ? std::string()
+           : fmt::format(" and {} at infinity", scene.infinite_lights.size())) +
       (scene.skipped_lights ? fmt::format(" ({} with zero emission skipped)", scene.skipped_lights)
                             : std::string());
   std::string part_text;
