@@ -113,7 +113,8 @@ struct Element {
 struct Header {
   Format format = Format::Ascii;
   std::vector<Element> elements;
-  size_t body = 0; // offset of the first byte after end_header's line
+  size_t body = 0;                // offset of the first byte after end_header's line
+  size_t after_first_element = 0; // offset of the line after the first "element" line
   // Offsets of the last letter of the vertex properties "texture_s" and "texture_t" (0: absent).
   size_t texture_s = 0, texture_t = 0;
 };
@@ -173,6 +174,7 @@ Header parse_header(const std::string& d, const std::string& prefix) {
       if (r.ec != std::errc() || r.ptr != t[2].data() + t[2].size())
         bad("expected \"element <name> <count>\"");
       e.name = t[1];
+      if (h.elements.empty()) h.after_first_element = pos;
       h.elements.push_back(std::move(e));
     } else if (t[0] == "property") {
       if (h.elements.empty()) bad("a property before any element");
@@ -321,6 +323,39 @@ void rename_texture_st(std::string& d, const Header& h) {
   d[h.texture_t] = 'v';
 }
 
+// Assimp 5.2's PLY reader skips whitespace after end_header's line even in a binary file, so a
+// body whose first byte is 0x09-0x0d or 0x20 (say, a little-endian float x whose low byte is
+// '\n') is read one or more bytes late: garbage, or an ai_assert abort in its triangulation.
+// Such a file gets a one-byte property "canopy_pad" ('!', not whitespace) before the others of
+// its first element, which must be "vertex" without lists (Assimp ignores unknown properties).
+void pad_binary_body(std::string& d, const Header& h, const std::string& prefix) {
+  if (h.format == Format::Ascii || h.body >= d.size()) return;
+  const char c = d[h.body];
+  if (c != ' ' && (c < '\t' || c > '\r')) return;
+  const Element& e = h.elements.front();
+  bool padded = e.name == "vertex";
+  size_t row = 0;
+  for (const Property& p : e.props) {
+    padded = padded && !p.list;
+    row += size_t(p.item.size);
+  }
+  if (!padded || row == 0)
+    fail(prefix, "not read: its binary data starts with a whitespace byte, which Assimp skips "
+                 "(only a first element \"vertex\" without list properties is worked around)");
+  std::string out;
+  out.reserve(d.size() + e.count + 32);
+  out.append(d, 0, h.after_first_element);
+  out += "property uchar canopy_pad\n";
+  out.append(d, h.after_first_element, h.body - h.after_first_element);
+  size_t pos = h.body; // check_binary has seen every row
+  for (uint64_t i = 0; i < e.count; ++i, pos += row) {
+    out += '!';
+    out.append(d, pos, row);
+  }
+  out.append(d, pos, std::string::npos);
+  d.swap(out);
+}
+
 std::string one_line(std::string s) {
   std::replace_if(
       s.begin(), s.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
@@ -349,6 +384,7 @@ PlyMesh load_ply_mesh(const std::filesystem::path& file, const std::string& pref
   // Assimp makes a point cloud of a file without faces; there is nothing to render in it.
   if (vertices == 0 || faces == 0) return out;
   rename_texture_st(data, h);
+  pad_binary_body(data, h, prefix);
 
   Assimp::Importer importer;
   // Triangulation only: no welding (aiProcess_JoinIdenticalVertices), no generated normals, no
