@@ -480,6 +480,8 @@ private:
   std::string one_string(const Token& d, Lexer& lx);
   void camera(const Token& d, Params& p, const std::string& type);
   void finish_camera(const Loc& loc);
+  // An "integer" parameter in [1, hi] into *out, if given.
+  void count_param(Params& p, const char* name, int hi, int* out);
   void shape(const Token& d, Params& p, const std::string& type, const std::filesystem::path& dir);
   void light_source(const Token& d, Params& p, const std::string& type,
                     const std::filesystem::path& base_dir);
@@ -1053,12 +1055,7 @@ void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& d
       p.finish();
     } else if (k == "Sampler") {
       need_world(false);
-      if (Param* q = p.one("pixelsamples", {"integer"})) {
-        if (!(q->nums[0] >= 1 && q->nums[0] <= kMaxSpp))
-          fail(q->loc,
-               fmt::format("{}: \"integer pixelsamples\": must be in [1, {}]", p.what(), kMaxSpp));
-        scene_.integrator.spp = int(q->nums[0]);
-      }
+      count_param(p, "pixelsamples", kMaxSpp, &scene_.integrator.spp);
       p.finish();
     } else if (k == "Integrator") {
       need_world(false);
@@ -1068,12 +1065,7 @@ void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& d
         warn(d.loc, fmt::format("Integrator \"{}\": rendered with Canopy's path tracer, the "
                                 "integrator ignored",
                                 printable(type)));
-      if (Param* q = p.one("maxdepth", {"integer"})) {
-        if (!(q->nums[0] >= 1 && q->nums[0] <= kMaxDepth))
-          fail(q->loc,
-               fmt::format("{}: \"integer maxdepth\": must be in [1, {}]", p.what(), kMaxDepth));
-        scene_.integrator.max_depth = int(q->nums[0]);
-      }
+      count_param(p, "maxdepth", kMaxDepth, &scene_.integrator.max_depth);
       p.finish();
     } else if (k == "Shape") {
       need_world(true);
@@ -1466,6 +1458,14 @@ void Reader::light_source(const Token& d, Params& p, const std::string& type,
     add_infinite_light(scene_, l, [&](const std::string& e) { fail(d.loc, e); });
   else
     scene_.lights.push_back(l);
+}
+
+void Reader::count_param(Params& p, const char* name, int hi, int* out) {
+  if (Param* q = p.one(name, {"integer"})) {
+    if (!(q->nums[0] >= 1 && q->nums[0] <= hi))
+      fail(q->loc, fmt::format("{}: \"integer {}\": must be in [1, {}]", p.what(), name, hi));
+    *out = int(q->nums[0]);
+  }
 }
 
 // pbrt-v4 "infinite": a constant L, or an equal-area octahedral image ("filename") in light space:
