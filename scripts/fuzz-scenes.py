@@ -953,8 +953,8 @@ PBRT_INSERTS = [
     'Sampler "halton" "integer pixelsamples" [0]', 'Integrator "path" "integer maxdepth" [-1]',
     'Integrator "path" "integer maxdepth" [100000]', 'Integrator "bdpt"',
 ]
-LONG_STRINGS = ["x" * 1000, "x" * 100000, "a\tb", "a\x1bb", "a\x00b", "\x7f", "\xff\xfe", "\xc3",
-                "%s%n", "../../../../etc/passwd", "ключ", "a\\b", "a\\"]
+LONG_STRINGS = [b"x" * 1000, b"x" * 100000, b"a\tb", b"a\x1bb", b"a\x00b", b"\x7f", b"\xff\xfe",
+                b"\xc3", b"%s%n", b"../../../../etc/passwd", "ключ".encode(), b"a\\b", b"a\\"]
 PLY_NAMES = ["mesh.ply", "mesh_be.ply", "mesh_le.ply.gz", "missing.ply", "/dev/zero", ".", "",
              "scene.pbrt", "plain.ply.gz", "/dev/null", "mesh.PLY", "x" * 5000 + ".ply"]
 
@@ -1133,7 +1133,7 @@ def pbrt_mutation(rng, toks, m, name):
             return False
         j = rng.choice(strs)
         v = rng.choice(LONG_STRINGS)
-        toks[j] = b'"' + v.encode("latin-1") + b'"'
+        toks[j] = b'"' + v + b'"'
         m.ops.append(f"{name}: string {j} -> {v[:30]!r} ({len(v)} chars)")
     elif c in ("ptype", "pname"):
         decls = [j for j, t in enumerate(toks) if re.fullmatch(rb'"\w+ +\w+"', t)]
@@ -1311,6 +1311,16 @@ def ply_parse(data):
     return fmt, elems, rows
 
 
+def ply_pack(end, code, x):
+    """x as the binary PLY scalar `code`; an integer out of range wraps like a C cast."""
+    if code in "fd":
+        return struct.pack(end + code, float(x))
+    bits = struct.calcsize(code) * 8
+    x = int(x) if not (isinstance(x, float) and (math.isnan(x) or math.isinf(x))) else 0
+    lo = -(1 << (bits - 1)) if code.islower() else 0
+    return struct.pack(end + code, (x - lo) % (1 << bits) + lo)
+
+
 def ply_write(fmt, elems, rows):
     h = [f"ply", f"format {fmt} 1.0"]
     for (name, n, props), er in zip(elems, rows):
@@ -1336,17 +1346,9 @@ def ply_write(fmt, elems, rows):
                 for (_, lt, ty), v in zip(props, row):
                     vs = v if lt else [v]
                     if lt:
-                        out += struct.pack(end + PLY_SCALARS[lt], len(vs) % 256 if lt in ("uchar", "uint8") else len(vs))
+                        out += ply_pack(end, PLY_SCALARS[lt], len(vs))
                     for x in vs:
-                        code = PLY_SCALARS[ty]
-                        if code in "fd":
-                            out += struct.pack(end + code, float(x))
-                        else:
-                            bits = struct.calcsize(code) * 8
-                            x = int(x) if not (isinstance(x, float) and (math.isnan(x) or math.isinf(x))) else 0
-                            lo = -(1 << (bits - 1)) if code.islower() else 0
-                            x = (x - lo) % (1 << bits) + lo  # wraps like a C cast
-                            out += struct.pack(end + code, x)
+                        out += ply_pack(end, PLY_SCALARS[ty], x)
     return bytes(out)
 
 
@@ -1395,8 +1397,9 @@ def ply_model_mutation(rng, data, m, name):
         ei = rng.randrange(len(elems))
         rows[ei] = rows[ei] * rng.choice([0, 2])
         what.append(f"{elems[ei][0]}: {len(rows[ei])} rows")
+    out = ply_write(fmt2, elems, rows)
     m.ops.append(f"{name}: re-encoded {', '.join(what) or 'unchanged'}")
-    return ply_write(fmt2, elems, rows)
+    return out
 
 
 def ply_header_mutation(rng, data, m, name):
@@ -1577,12 +1580,14 @@ def ply_mutation(rng, files, m):
     out = None
     for _ in range(rng.choice([1, 1, 2])):
         c = rng.randrange(10)
-        if c < 4:
-            new = ply_header_mutation(rng, data, m, name)
-        elif c < 7:
-            new = ply_body_mutation(rng, data, m, name)
-        elif c < 9:
-            new = ply_model_mutation(rng, data, m, name)
+        fn = ply_header_mutation if c < 4 else ply_body_mutation if c < 7 else \
+            ply_model_mutation if c < 9 else None
+        if fn:
+            # The second mutation may meet a header the first broke: then it does nothing.
+            try:
+                new = fn(rng, data, m, name)
+            except (ValueError, IndexError, KeyError, struct.error):
+                new = None
         else:
             new = b_mutate(rng, data, m)
             m.ops[-1] = f"{name}: bytes: {m.ops[-1]}"
