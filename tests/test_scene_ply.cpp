@@ -267,9 +267,9 @@ TEST(ScenePly, BrokenFilesAreOneLineErrorsAfterThePrefix) {
        ascii.substr(0, ascii_body) + "0.1 x 3" + ascii.substr(ascii.find('\n', ascii_body)),
        "line 16: vertex 1 of 5: 'x' is not a number"},
       {"index_out_of_range.ply", ply_bytes(oob, Enc::LittleEndian),
-       "a face has the vertex index 5, out of range [0, 5)"},
+       "face 2 of 2: the vertex index 5 is out of range [0, 5)"},
       {"negative_index.ply", ply_bytes(negative, Enc::Ascii),
-       "a face has the vertex index -1, out of range [0, 5)"},
+       "line 22: face 2 of 2: the vertex index -1 is out of range [0, 5)"},
       {"long_face.ply", ascii.substr(0, ascii.rfind("3 1")) + "2000 1 4 2\n",
        "line 22: face 2 of 2: list \"vertex_indices\" has the length '2000'"},
       {"not_gzip.ply.gz", le, "not a gzip file (the name ends in .gz)"},
@@ -287,6 +287,30 @@ TEST(ScenePly, BrokenFilesAreOneLineErrorsAfterThePrefix) {
   write(d / "cut.ply.gz", gz.substr(0, gz.size() / 2));
   EXPECT_EQ(error_of(d / "cut.ply.gz"), "p: truncated gzip data");
   EXPECT_EQ(error_of(d / "missing.ply"), "p: cannot open file");
+}
+
+// Face indices are checked before Assimp reads the file: its triangulation reads a polygon's
+// vertices by index, so an index far out of range in a quad crashed it (SIGSEGV; found by the
+// fuzzer: a binary file with bytes deleted in its vertices, whose faces then read garbage).
+TEST(ScenePly, OutOfRangeIndicesOfPolygonsAreErrorsBeforeAssimp) {
+  fs::path d = temp_dir();
+  for (Enc enc : {Enc::Ascii, Enc::LittleEndian, Enc::BigEndian})
+    for (int32_t bad : {100000000, -100000000, 5}) {
+      Ply p = kQuadAndTriangle;
+      ASSERT_EQ(p.faces[0].size(), 4u);
+      p.faces[0][2] = bad;
+      write(d / "q.ply", ply_bytes(p, enc));
+      std::string e = error_of(d / "q.ply");
+      EXPECT_NE(e.find("face 1 of 2: the vertex index " + std::to_string(bad) +
+                       " is out of range [0, 5)"),
+                std::string::npos)
+          << e;
+    }
+  // The fuzzer's reproduction: a polygon whose count and indices are vertex bytes.
+  Ply shifted = kQuadAndTriangle;
+  shifted.faces[0] = {0, 1, 2, 3, 4, 0x3e99999a};
+  write(d / "s.ply", ply_bytes(shifted, Enc::BigEndian));
+  EXPECT_NE(error_of(d / "s.ply").find("is out of range [0, 5)"), std::string::npos);
 }
 
 // Assimp's logger stays silent (no DefaultLogger is created).

@@ -202,13 +202,33 @@ Header parse_header(const std::string& d, const std::string& prefix) {
 
 // A list's length limit: faces as for OBJ (Assimp triangulates in quadratic time); other lists
 // are only skipped over.
-uint64_t max_list(const Element& e, const Property& p) {
-  bool face = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
-  return face ? uint64_t(kMaxPolygonVertices) : UINT64_MAX;
-}
-
 std::string where(const Element& e, uint64_t i) {
   return fmt::format("{} {} of {}", printable(e.name, 40), i + 1, e.count);
+}
+
+bool face_indices(const Element& e, const Property& p) {
+  return e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
+}
+
+uint64_t max_list(const Element& e, const Property& p) {
+  return face_indices(e, p) ? uint64_t(kMaxPolygonVertices) : UINT64_MAX;
+}
+
+// The vertex count the header declares (0 without a vertex element).
+uint64_t vertex_count(const Header& h) {
+  uint64_t n = 0;
+  for (const Element& e : h.elements)
+    if (e.name == "vertex") n = e.count;
+  return n;
+}
+
+// Face indices are checked before Assimp sees them: its triangulation reads the vertices of a
+// polygon by index, so one out of range crashes it.
+void check_index(double v, const Element& e, uint64_t i, uint64_t vertices,
+                 const std::string& prefix) {
+  if (!(v >= 0.0 && v < double(vertices)))
+    fail(prefix, fmt::format("{}: the vertex index {} is out of range [0, {})", where(e, i),
+                             fmt::format("{}", v), vertices));
 }
 
 // The value of a binary integer of type t at p.
@@ -222,8 +242,26 @@ int64_t read_int(const char* p, const ScalarType& t, bool big_endian) {
   return int64_t(u);
 }
 
+// The value of a binary scalar of type t at p, as double.
+double read_value(const char* p, const ScalarType& t, bool big_endian) {
+  if (t.integer) return double(read_int(p, t, big_endian));
+  ScalarType bits = t;
+  bits.is_signed = false;
+  const uint64_t u = uint64_t(read_int(p, bits, big_endian));
+  if (t.size == 4) {
+    float f;
+    const uint32_t u32 = uint32_t(u);
+    std::memcpy(&f, &u32, 4);
+    return double(f);
+  }
+  double v;
+  std::memcpy(&v, &u, 8);
+  return v;
+}
+
 void check_binary(const std::string& d, const Header& h, const std::string& prefix) {
   const bool be = h.format == Format::BinaryBE;
+  const uint64_t vertices = vertex_count(h);
   size_t pos = h.body;
   auto truncated = [&](const Element& e, uint64_t i) {
     fail(prefix, fmt::format("truncated: the file ends in {} ({} bytes)", where(e, i), d.size()));
@@ -253,6 +291,10 @@ void check_binary(const std::string& d, const Header& h, const std::string& pref
           n = uint64_t(c);
         }
         if (n > (d.size() - pos) / uint64_t(p.item.size)) truncated(e, i);
+        if (face_indices(e, p))
+          for (uint64_t j = 0; j < n; ++j)
+            check_index(read_value(d.data() + pos + j * uint64_t(p.item.size), p.item, be), e, i,
+                        vertices, prefix);
         pos += size_t(n * uint64_t(p.item.size));
       }
   }
@@ -275,6 +317,7 @@ bool numeric(std::string_view tok, bool integer, int64_t* value = nullptr) {
 // One element instance per line (blank lines are skipped, as Assimp does); values past the
 // element's properties are ignored, as Assimp does.
 void check_ascii(const std::string& d, const Header& h, const std::string& prefix) {
+  const uint64_t vertices = vertex_count(h);
   size_t pos = h.body;
   int line_no = int(std::count(d.begin(), d.begin() + ptrdiff_t(h.body), '\n'));
   for (const Element& e : h.elements)
@@ -304,10 +347,20 @@ void check_ascii(const std::string& d, const Header& h, const std::string& prefi
           n = uint64_t(c);
         }
         if (n > t.size() - k) bad("too few values");
-        for (uint64_t j = 0; j < n; ++j, ++k)
+        for (uint64_t j = 0; j < n; ++j, ++k) {
           if (!numeric(t[k], p.item.integer))
             bad(fmt::format("'{}' is not a{} number", printable(t[k], 40),
                             p.item.integer ? "n integer" : ""));
+          if (face_indices(e, p)) {
+            std::string_view tok = t[k];
+            if (tok.size() > 1 && tok[0] == '+') tok.remove_prefix(1);
+            double v = 0.0;
+            std::from_chars(tok.data(), tok.data() + tok.size(), v);
+            if (!(v >= 0.0 && v < double(vertices)))
+              bad(fmt::format("the vertex index {} is out of range [0, {})", printable(t[k], 40),
+                              vertices));
+          }
+        }
       }
     }
 }
