@@ -1,20 +1,23 @@
 #!/usr/bin/env python3
-"""Mutation fuzzer for `canopy render`: scene JSON, OBJ/MTL files and special files.
+"""Mutation fuzzer for `canopy render`: scene JSON, OBJ/MTL, pbrt-v4 and PLY files, special files.
 
-Every mutant is a scene (plus any OBJ/MTL it needs) in its own directory, rendered with
-`canopy render scene.json --spp 1 --out out.exr` at an 8 x 8 film (the film is rewritten in the
-seed before mutation, so only mutations aimed at `film` change it). An outcome passes when it is
+Every mutant is a scene (plus any OBJ/MTL it needs; for pbrt, scene.pbrt plus the files it
+includes and the PLY files it references) in its own directory, rendered with
+`canopy render scene.json --spp 1 --out out.exr` (scene.pbrt) at an 8 x 8 film (the film is
+rewritten in the seed before mutation, so only mutations aimed at `film` change it). An outcome
+passes when it is
 
   * exit 0 and out.exr exists with every pixel finite (checked with `iinfo --stats`), or
   * exit 2 and stderr is exactly one line, without control bytes, valid UTF-8, that begins with
-    the scene path as given (when that path is printable).
+    the scene path as given (when that path is printable); for pbrt, with `FILE: ` or
+    `FILE:LINE: ` where FILE is the scene path or one of the mutant's files.
 
 Anything else fails: a timeout, a signal, exit 1, any other exit code, a multi-line or unescaped
 exit-2 message, a missing or non-finite image. Each failing mutant is moved to OUT/failures/<id>
 with `cmd.sh` (reproduces it), `stdout.txt`, `stderr.txt` and `result.txt`.
 
-Mutant i depends only on --seed and i (not on --count or --jobs), so a failure is reproduced by
-`--seed S --only i`. Standard library only. docs/testing.md has the short and the long form.
+Mutant i depends only on --seed, --formats and i (not on --count or --jobs), so a failure is
+reproduced by `--seed S [--formats F] --only i`. Standard library only. docs/testing.md has the short and the long form.
 """
 
 import argparse
