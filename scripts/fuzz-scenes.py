@@ -1545,7 +1545,7 @@ def gzip_mutation(rng, gz, m, name):
         n = rng.randint(1, 4)
         for _ in range(n):
             d[rng.randrange(10, len(d) - 8)] = rng.randrange(256)
-        m.ops.append(f"{name}: {n} deflate bytes flipped")
+        m.ops.append(f"{name}: gzip: {n} deflate bytes flipped")
     elif c == 2:
         k = len(d) - rng.randint(1, 8)
         d[k] ^= 0xFF
@@ -1553,11 +1553,11 @@ def gzip_mutation(rng, gz, m, name):
     elif c == 3:
         extra = rng.choice([gz, b"\x1f\x8b", b"garbage", b"\x00" * 8, gzip_bytes(b"")])
         d += extra
-        m.ops.append(f"{name}: {len(extra)} bytes after the gzip member")
+        m.ops.append(f"{name}: gzip: {len(extra)} bytes after the member")
     elif c == 4:
         d = bytearray(rng.choice([b"", b"\x1f\x8b", gz[:10], gzip_bytes(b""),
                                   gzip_bytes(b"ply\nformat ascii 1.0\nend_header\n")]))
-        m.ops.append(f"{name}: replaced by {bytes(d)[:12]!r} ({len(d)} bytes)")
+        m.ops.append(f"{name}: gzip: replaced by {bytes(d)[:12]!r} ({len(d)} bytes)")
     elif c == 5:
         d[3] |= rng.choice([0x04, 0x08, 0x10, 0x02, 0xE0])  # FEXTRA/FNAME/FCOMMENT/FHCRC/reserved
         m.ops.append(f"{name}: gzip flags {d[3]:#x}")

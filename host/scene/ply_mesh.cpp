@@ -148,6 +148,9 @@ Header parse_header(const std::string& d, const std::string& prefix) {
     auto bad = [&](std::string_view what) {
       fail(prefix, fmt::format("header line {}: {}", line_no, what));
     };
+    // Assimp's header parser stops at a NUL (a C string): it would read another layout than
+    // the one checked here.
+    if (line.find('\0') != std::string_view::npos) bad("a NUL byte");
     if (line_no == 1) {
       if (t.size() != 1 || (t[0] != "ply" && t[0] != "PLY"))
         fail(prefix, "not a PLY file (it does not start with \"ply\")");
