@@ -1681,8 +1681,8 @@ def pbrt_special_cases():
 # ------------------------------------------------------------------ mutant generation
 CATEGORIES = [("json", 55), ("bytes", 15), ("obj", 30)]
 # The share of pbrt-v4 mutants (a pbrt file mutated, or a PLY file it references) among the
-# random ones; --formats json / pbrt leaves the other out (one draw either way, so mutant i of a
-# --formats pbrt run is mutant i of a full run whenever that one is a pbrt mutant).
+# random ones; --formats json / pbrt leaves the other out (mutant i of a --formats pbrt run is
+# mutant i of a full run whenever that one is a pbrt mutant).
 FORMATS = [("json", 70), ("pbrt", 30)]
 PBRT_CATEGORIES = [("pbrt", 65), ("ply", 35)]
 
@@ -1712,7 +1712,10 @@ def make_mutant(ident, base_seed, seeds, specials, pbrt_seeds, formats):
         m.expect_error = expect[0] if expect else kind.startswith(("scene-", "obj-", "mtl-", "cli "))
         return m
     rng = random.Random(f"{base_seed}/{ident}")
-    if weighted(rng, [f for f in FORMATS if f[0] in formats]) == "pbrt":
+    # The format from a stream of its own: a JSON mutant i is the one it was before pbrt mutants
+    # existed, a pbrt mutant i the same in a --formats pbrt run.
+    fmt_rng = random.Random(f"{base_seed}/{ident}/format")
+    if weighted(fmt_rng, [f for f in FORMATS if f[0] in formats]) == "pbrt":
         return make_pbrt_mutant(rng, ident, pbrt_seeds, weighted(rng, PBRT_CATEGORIES))
     for _attempt in range(50):
         seed_path, seed_tree = rng.choice(seeds)
