@@ -1108,7 +1108,8 @@ def pbrt_mutation(rng, toks, m, name):
             m.ops.append(f"{name}: number {k} {toks[k]!r} -> {v!r}")
             toks[k] = v
         else:
-            s, e = rng.choice([sp for sp in spans if any(s <= k < sp[1] for s in [sp[0]] for k in nums)] or spans)
+            with_numbers = [(a, b) for a, b in spans if any(a <= k < b for k in nums)]
+            s, e = rng.choice(with_numbers or spans)
             for k in range(s, e):
                 if is_pbrt_number(toks[k]):
                     toks[k] = v
