@@ -306,6 +306,17 @@ TEST(ScenePly, OutOfRangeIndicesOfPolygonsAreErrorsBeforeAssimp) {
                 std::string::npos)
           << e;
     }
+  // A float index list: 1e999 (out of the double range) and NaN are out of range too.
+  for (const char* bad : {"1e999", "nan", "-0.5e10"}) {
+    std::string a = ply_bytes(kQuadAndTriangle, Enc::Ascii);
+    a.replace(a.find("list uchar int"), 14, "list uchar float");
+    a.replace(a.rfind("4 0 1 2 3"), 9, std::string("4 0 1 ") + bad + " 3");
+    write(d / "f.ply", a);
+    std::string e = error_of(d / "f.ply");
+    EXPECT_NE(e.find(std::string("face 1 of 2: the vertex index ") + bad + " is out of range"),
+              std::string::npos)
+        << e;
+  }
   // The fuzzer's reproduction: a polygon whose count and indices are vertex bytes.
   Ply shifted = kQuadAndTriangle;
   shifted.faces[0] = {0, 1, 2, 3, 4, 0x3e99999a};
@@ -313,16 +324,31 @@ TEST(ScenePly, OutOfRangeIndicesOfPolygonsAreErrorsBeforeAssimp) {
   EXPECT_NE(error_of(d / "s.ply").find("is out of range [0, 5)"), std::string::npos);
 }
 
-// A NUL byte in the header is an error: Assimp's header parser and Canopy's would read different
-// layouts (a comment "a\0b" between two vertex properties crashed Assimp; found by the fuzzer).
-TEST(ScenePly, ANulByteInTheHeaderIsAnError) {
+// A control byte in the header is an error: Assimp's header parser and Canopy's would read
+// different layouts (a comment "a\0b" between two vertex properties, "end_header\r\r\n" crashed
+// Assimp; found by the fuzzer).
+TEST(ScenePly, AControlByteInTheHeaderIsAnError) {
   fs::path d = temp_dir();
   for (Enc enc : {Enc::Ascii, Enc::LittleEndian, Enc::BigEndian}) {
     std::string b = ply_bytes(kQuadAndTriangle, enc);
     const size_t at = b.find("property float z\n");
     b = b.substr(0, at) + std::string("comment a\0b\xff\n", 13) + b.substr(at);
     write(d / "nul.ply", b);
-    EXPECT_EQ(error_of(d / "nul.ply"), "p: header line 7: a NUL byte");
+    EXPECT_EQ(error_of(d / "nul.ply"), "p: header line 7: a control byte (0x00)");
+    // A CR before the CRLF of end_header: Assimp started the body one byte early.
+    std::string crcr = ply_bytes(kQuadAndTriangle, enc);
+    crcr.replace(crcr.find("end_header\n"), 11, "end_header\r\r\n");
+    write(d / "crcr.ply", crcr);
+    EXPECT_EQ(error_of(d / "crcr.ply"), "p: header line 15: a control byte (0x0d)");
+    // CRLF lines are fine.
+    const std::string lf = ply_bytes(kQuadAndTriangle, enc);
+    const size_t body = lf.find("end_header\n") + 11;
+    std::string crlf;
+    for (size_t k = 0; k < body; ++k)
+      crlf += lf[k] == '\n' ? std::string("\r\n") : std::string(1, lf[k]);
+    crlf += lf.substr(body);
+    write(d / "crlf.ply", crlf);
+    expect_quad_and_triangle(load(d / "crlf.ply"));
   }
 }
 

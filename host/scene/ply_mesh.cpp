@@ -148,14 +148,20 @@ Header parse_header(const std::string& d, const std::string& prefix) {
     auto bad = [&](std::string_view what) {
       fail(prefix, fmt::format("header line {}: {}", line_no, what));
     };
-    // Assimp's header parser stops at a NUL (a C string): it would read another layout than
-    // the one checked here.
-    if (line.find('\0') != std::string_view::npos) bad("a NUL byte");
-    if (line_no == 1) {
-      if (t.size() != 1 || (t[0] != "ply" && t[0] != "PLY"))
-        fail(prefix, "not a PLY file (it does not start with \"ply\")");
-      continue;
+    if (line_no == 1 && (t.size() != 1 || (t[0] != "ply" && t[0] != "PLY")))
+      fail(prefix, "not a PLY file (it does not start with \"ply\")");
+    // Assimp's header parser ends a line at a NUL or a CR (and skips the next line after one it
+    // does not know): with a control byte in a line it would read another layout than the one
+    // checked here (a NUL in a comment, "end_header\r\r\n" crashed it). Only a line's last CR
+    // (CRLF) is allowed, and tabs.
+    {
+      std::string_view l = line;
+      if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+      for (char c : l)
+        if ((uint8_t(c) < 0x20 && c != '\t') || uint8_t(c) == 0x7f)
+          bad(fmt::format("a control byte (0x{:02x})", uint8_t(c)));
     }
+    if (line_no == 1) continue;
     if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
     if (t[0] == "end_header") break;
     if (t[0] == "format") {
@@ -203,8 +209,6 @@ Header parse_header(const std::string& d, const std::string& prefix) {
   return h;
 }
 
-// A list's length limit: faces as for OBJ (Assimp triangulates in quadratic time); other lists
-// are only skipped over.
 std::string where(const Element& e, uint64_t i) {
   return fmt::format("{} {} of {}", printable(e.name, 40), i + 1, e.count);
 }
@@ -213,16 +217,19 @@ bool face_indices(const Element& e, const Property& p) {
   return e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
 }
 
+// A list's length limit: faces as for OBJ (Assimp triangulates in quadratic time); other lists
+// are only skipped over.
 uint64_t max_list(const Element& e, const Property& p) {
   return face_indices(e, p) ? uint64_t(kMaxPolygonVertices) : UINT64_MAX;
 }
 
-// The vertex count the header declares (0 without a vertex element).
+// The vertex count the header declares (0 without a vertex element; the smallest if there are
+// several, whichever of them Assimp reads).
 uint64_t vertex_count(const Header& h) {
-  uint64_t n = 0;
+  uint64_t n = UINT64_MAX;
   for (const Element& e : h.elements)
-    if (e.name == "vertex") n = e.count;
-  return n;
+    if (e.name == "vertex") n = std::min(n, e.count);
+  return n == UINT64_MAX ? 0 : n;
 }
 
 // Face indices are checked before Assimp sees them: its triangulation reads the vertices of a
@@ -358,8 +365,8 @@ void check_ascii(const std::string& d, const Header& h, const std::string& prefi
             std::string_view tok = t[k];
             if (tok.size() > 1 && tok[0] == '+') tok.remove_prefix(1);
             double v = 0.0;
-            std::from_chars(tok.data(), tok.data() + tok.size(), v);
-            if (!(v >= 0.0 && v < double(vertices)))
+            auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+            if (r.ec != std::errc() || !(v >= 0.0 && v < double(vertices)))
               bad(fmt::format("the vertex index {} is out of range [0, {})", printable(t[k], 40),
                               vertices));
           }
