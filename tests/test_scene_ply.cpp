@@ -352,6 +352,22 @@ TEST(ScenePly, AControlByteInTheHeaderIsAnError) {
   }
 }
 
+// Comment, obj_info and blank lines may be anywhere in the header (Assimp 5.2 ended an element's
+// properties at one, read another layout and crashed; found by the fuzzer).
+TEST(ScenePly, CommentsBetweenPropertiesAreRead) {
+  fs::path d = temp_dir();
+  for (Enc enc : {Enc::Ascii, Enc::LittleEndian, Enc::BigEndian}) {
+    std::string b = ply_bytes(kQuadAndTriangle, enc);
+    for (const char* before : {"property float z\n", "element vertex", "property float nx\n",
+                               "property list", "end_header"}) {
+      const size_t at = b.find(before);
+      b = b.substr(0, at) + "obj_info x\ncomment y\n  \n" + b.substr(at);
+    }
+    write(d / "o.ply", b);
+    expect_quad_and_triangle(load(d / "o.ply"));
+  }
+}
+
 // Assimp's logger stays silent (no DefaultLogger is created).
 TEST(ScenePly, NothingIsPrintedOnALoadOrAnError) {
   fs::path d = temp_dir();

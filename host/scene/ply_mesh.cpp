@@ -116,6 +116,8 @@ struct Header {
   size_t body = 0; // offset of the first byte after end_header's line
   // Offsets of the last letter of the vertex properties "texture_s" and "texture_t" (0: absent).
   size_t texture_s = 0, texture_t = 0;
+  // [begin, end) of each comment, obj_info and blank line (with its line end).
+  std::vector<std::pair<size_t, size_t>> comments;
 };
 
 std::vector<std::string_view> split(std::string_view line) {
@@ -162,7 +164,10 @@ Header parse_header(const std::string& d, const std::string& prefix) {
           bad(fmt::format("a control byte (0x{:02x})", uint8_t(c)));
     }
     if (line_no == 1) continue;
-    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") {
+      h.comments.push_back({size_t(line.data() - d.data()), pos});
+      continue;
+    }
     if (t[0] == "end_header") break;
     if (t[0] == "format") {
       if (t.size() != 3) bad("expected \"format <type> <version>\"");
@@ -412,6 +417,20 @@ PlyMesh load_ply_mesh(const std::filesystem::path& file, const std::string& pref
   // Assimp makes a point cloud of a file without faces; there is nothing to render in it.
   if (vertices == 0 || faces == 0) return out;
   rename_texture_st(data, h);
+  // Assimp 5.2 ends an element's properties at a comment, obj_info or blank line and then skips
+  // the properties after it (so it read another layout than the one checked and crashed; found by
+  // the fuzzer): those lines are removed from the header before it reads the file.
+  if (!h.comments.empty()) {
+    std::string kept;
+    kept.reserve(data.size());
+    size_t from = 0;
+    for (const auto& [begin, end] : h.comments) {
+      kept.append(data, from, begin - from);
+      from = end;
+    }
+    kept.append(data, from, std::string::npos);
+    data = std::move(kept);
+  }
 
   Assimp::Importer importer;
   // Triangulation only: no welding (aiProcess_JoinIdenticalVertices), no generated normals, no
