@@ -1,25 +1,30 @@
 #!/usr/bin/env python3
-"""Mutation fuzzer for `canopy render`: scene JSON, OBJ/MTL files and special files.
+"""Mutation fuzzer for `canopy render`: scene JSON, OBJ/MTL, pbrt-v4 and PLY files, special files.
 
-Every mutant is a scene (plus any OBJ/MTL it needs) in its own directory, rendered with
-`canopy render scene.json --spp 1 --out out.exr` at an 8 x 8 film (the film is rewritten in the
-seed before mutation, so only mutations aimed at `film` change it). An outcome passes when it is
+Every mutant is a scene (plus any OBJ/MTL it needs; for pbrt, scene.pbrt plus the files it
+includes and the PLY files it references) in its own directory, rendered with
+`canopy render scene.json --spp 1 --out out.exr` (scene.pbrt) at an 8 x 8 film (the film is
+rewritten in the seed before mutation, so only mutations aimed at `film` change it). An outcome
+passes when it is
 
   * exit 0 and out.exr exists with every pixel finite (checked with `iinfo --stats`), or
   * exit 2 and stderr is exactly one line, without control bytes, valid UTF-8, that begins with
-    the scene path as given (when that path is printable).
+    the scene path as given (when that path is printable); for pbrt, with `FILE: ` or
+    `FILE:LINE: ` where FILE is the scene path or one of the mutant's files.
 
 Anything else fails: a timeout, a signal, exit 1, any other exit code, a multi-line or unescaped
 exit-2 message, a missing or non-finite image. Each failing mutant is moved to OUT/failures/<id>
 with `cmd.sh` (reproduces it), `stdout.txt`, `stderr.txt` and `result.txt`.
 
-Mutant i depends only on --seed and i (not on --count or --jobs), so a failure is reproduced by
-`--seed S --only i`. Standard library only. docs/testing.md has the short and the long form.
+Mutant i depends only on --seed, --formats and i (not on --count or --jobs), so a failure is
+reproduced by `--seed S [--formats F] --only i`. Standard library only. docs/testing.md has the short and the long form.
 """
 
 import argparse
 import concurrent.futures
 import copy
+import gzip
+import io
 import json
 import math
 import os
@@ -27,6 +32,7 @@ import random
 import re
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 import threading
@@ -273,6 +279,7 @@ class Mutant:
         self.args = []  # extra command-line options (CLI cases)
         self.expect_error = False  # exit 0 is a failure too (input that must be refused)
         self.names = None  # what the one-line error must begin with (default: the scene path)
+        self.pbrt = False  # a pbrt scene: the error may begin with any file of the mutant
 
 
 def pick_slot(rng, tree, pred):
@@ -884,8 +891,801 @@ def special_cases():
     return cases
 
 
+# ------------------------------------------------------------------ pbrt-v4 scenes
+# A pbrt mutant is a directory of files: scene.pbrt (the seed's top-level file, renamed), the
+# files it includes and the PLY meshes it references, under their own names. Its film is 8 x 8.
+PBRT_FILM = b'Film "rgb" "integer xresolution" [8] "integer yresolution" [8]\n' \
+            b'Sampler "zsobol" "integer pixelsamples" [1]\n'
+PBRT_MAX_PIXELS = 65536  # a larger legal film (1280 x 720 when Film is dropped) only costs time
+PBRT_TOKEN = re.compile(rb'"[^"\n]*"?|\[|\]|#[^\n]*|[^\s\[\]"#]+')
+PBRT_EXTREMES = [
+    "0", "-0", "-1", "1e-45", "1e-40", "1e38", "-1e38", "3e38", "3.5e38", "1e39", "-1e39",
+    "1e308", "1e999", "-1e999", "nan", "NaN", "inf", "-inf", "Infinity", "2147483647",
+    "2147483648", "4294967295", "4294967296", "-2147483649", "18446744073709551616",
+    "123456789012345678901234567890", "0x10", "1.5.5", "1e", "+", "-", ".", "--1", "1e18", "1e19",
+    "16385", "100000", "0.5",
+]
+PBRT_TYPES = ["float", "integer", "string", "bool", "rgb", "blackbody", "spectrum", "point3",
+              "point2", "point", "normal", "normal3", "vector3", "vector", "texture", "color",
+              "bogus", "", "Float"]
+PBRT_INSERTS = [
+    "AttributeEnd", "TransformEnd", "ObjectEnd", "AttributeBegin", "TransformBegin",
+    'ObjectBegin "o"', "WorldBegin", "WorldEnd", "ReverseOrientation", "Identity",
+    'Include "scene.pbrt"', 'Include "scene-inc.pbrt"', 'Import "scene.pbrt"', 'Include "./scene.pbrt"',
+    'Include "missing.pbrt"', 'Include "/dev/zero"', 'Include "/dev/null"', 'Include "."',
+    'Include ""', 'Include "mesh_be.ply"', 'Include "nodir/x.pbrt"', "Include",
+    'Frobnicate "x" 1 2 [3]', "frob", "ActiveTransform StartTime", "TransformTimes 0 1",
+    'MakeNamedMedium "m" "string type" "homogeneous"', 'MediumInterface "m" ""',
+    'Attribute "shape" "float radius" 2', 'Option "bool disablepixeljitter" true',
+    'ColorSpace "aces2065-1"', 'PixelFilter "gaussian"', 'Accelerator "bvh"',
+    'Camera "orthographic"', 'Camera "perspective" "float fov" [179.999]',
+    'Camera "perspective" "float fov" [0]', 'Camera "perspective" "float fov" [180]',
+    'Texture "t" "spectrum" "imagemap" "string filename" "missing.png"',
+    'Material "diffuse" "texture reflectance" "t"', 'LightSource "goniometric"',
+    'LightSource "infinite" "string filename" "missing.exr"',
+    'LightSource "infinite" "string filename" "mesh.ply"',
+    'LightSource "infinite" "rgb L" [1 1 1] "string filename" "x.exr"',
+    'LightSource "distant" "rgb L" [1 1 1]', 'LightSource "point" "rgb I" [1 1 1] "float power" 10',
+    'LightSource "spot" "float coneangle" [0] "float conedelta" [0]',
+    'LightSource "spot" "float coneangle" [-1] "float conedelta" [90]',
+    'AreaLightSource "diffuse" "rgb L" [3e38 3e38 3e38]', 'AreaLightSource "diffuse" "rgb L" [-1 0 0]',
+    'Shape "curve"', 'Shape "plymesh"', 'Shape "plymesh" "string filename" "missing.ply"',
+    'Shape "plymesh" "string filename" "/dev/zero"', 'Shape "plymesh" "string filename" "."',
+    'Shape "plymesh" "string filename" "scene.pbrt"', 'Shape "plymesh" "string filename" "mesh.ply.gz"',
+    'Shape "plymesh" "string filename" "/dev/null"', 'Shape "trianglemesh"',
+    'Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 5]',
+    'Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0]',
+    'Shape "trianglemesh" "point3 P" [0 0 0 0 0 0 0 0 0]',
+    'Shape "bilinearmesh" "point3 P" [0 0 0 1 0 0 0 1 0]', 'Shape "sphere" "float radius" [-1]',
+    'Shape "sphere" "float radius" [0]', 'Shape "sphere" "float radius" [1e30]',
+    'Shape "sphere" "float zmin" [0.5] "float zmax" [-0.5]', 'Shape "disk" "float radius" [0]',
+    'Shape "disk" "float innerradius" [2] "float radius" [1]', 'NamedMaterial "nosuch"',
+    'ObjectInstance "nosuch"', 'ObjectInstance "pair"', 'CoordSysTransform "nosuch"',
+    'CoordSysTransform "camera"', 'MakeNamedMaterial "red" "string type" "diffuse"',
+    'MakeNamedMaterial "x" "string type" "nosuch"', 'MakeNamedMaterial "x"',
+    'Material "conductor" "spectrum eta" "metal-Xx-eta" "float roughness" [-1]',
+    'Material "conductor" "float reflectance" [1]', 'Material "coateddiffuse" "float eta" [0]',
+    'Material "diffuse" "rgb reflectance" [1e39 0 0]', "Scale 0 0 0", "Scale 1e30 1e30 1e30",
+    "Scale 1e-30 1e-30 1e-30", "Scale -1 1 1", "Translate 1e19 0 0", "Translate 1e17 0 0",
+    "Rotate 90 0 0 0", "Rotate 1e30 0 1 0", "LookAt 0 0 0 0 0 0 0 1 0", "LookAt 0 0 0 0 0 1 0 0 1",
+    "Transform [0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0]", "Transform [1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 0]",
+    "ConcatTransform [1 0 0 1 0 1 0 0 0 0 1 0 0 0 0 1]", "Transform [1 2 3]",
+    'Film "rgb" "integer xresolution" [0]', 'Film "rgb" "integer xresolution" [16385]',
+    'Film "rgb" "integer xresolution" [2147483648] "integer yresolution" [8]',
+    'Film "rgb" "float scale" [1e38] "float iso" [1e38]', 'Film "gbuffer" "string filename" "x.png"',
+    'Sampler "halton" "integer pixelsamples" [0]', 'Integrator "path" "integer maxdepth" [-1]',
+    'Integrator "path" "integer maxdepth" [100000]', 'Integrator "bdpt"',
+]
+LONG_STRINGS = [b"x" * 1000, b"x" * 100000, b"a\tb", b"a\x1bb", b"a\x00b", b"\x7f", b"\xff\xfe",
+                b"\xc3", b"%s%n", b"../../../../etc/passwd", "ключ".encode(), b"a\\b", b"a\\"]
+PLY_NAMES = ["mesh.ply", "mesh_be.ply", "mesh_le.ply.gz", "missing.ply", "/dev/zero", ".", "",
+             "scene.pbrt", "plain.ply.gz", "/dev/null", "mesh.PLY", "x" * 5000 + ".ply"]
+
+
+def pbrt_tokens(data):
+    """The tokens of a pbrt file (bytes), comments left out."""
+    return [t for t in PBRT_TOKEN.findall(data) if not t.startswith(b"#")]
+
+
+def is_directive(t):
+    return t[:1].isalpha() and t not in (b"true", b"false")
+
+
+def is_pbrt_number(t):
+    return bool(re.fullmatch(rb"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?", t))
+
+
+def pbrt_join(tokens):
+    out = bytearray()
+    for t in tokens:
+        if out:
+            out += b"\n" if is_directive(t) else b" "
+        out += t
+    return bytes(out) + b"\n"
+
+
+def pbrt_refs(data):
+    """Relative files a pbrt file names: Include/Import targets and "string filename" values."""
+    toks, refs = pbrt_tokens(data), []
+    for k, t in enumerate(toks[:-1]):
+        nxt = toks[k + 1]
+        if t in (b"Include", b"Import") or re.fullmatch(rb'"string\s+filename"', t):
+            if nxt.startswith(b'"') and nxt.endswith(b'"') and len(nxt) > 1:
+                refs.append(nxt[1:-1].decode())
+    return refs
+
+
+def pbrt_normalize(data):
+    """Drops Film and Sampler directives (an 8 x 8 film and 1 spp are put first instead)."""
+    toks, out, skip = pbrt_tokens(data), [], False
+    for t in toks:
+        if is_directive(t):
+            skip = t in (b"Film", b"Sampler")
+        if not skip:
+            out.append(t)
+    return out
+
+
+def load_pbrt_seeds():
+    """[(path, {name: bytes})]: every top-level .pbrt file of scenes/pbrt/ and tests/fuzz/ with
+    the files it references (Include, PLY, ...), normalised to an 8 x 8 film and 1 spp."""
+    paths = sorted((ROOT / "scenes/pbrt").glob("*.pbrt")) + sorted(
+        (ROOT / "tests/fuzz").glob("*.pbrt"))
+    included = set()
+    for p in paths:
+        for r in pbrt_refs(p.read_bytes()):
+            included.add((p.parent / r).resolve())
+    seeds = []
+    for p in paths:
+        if p.resolve() in included:
+            continue
+        files, todo = {}, [(p, "scene.pbrt")]
+        while todo:
+            src, name = todo.pop()
+            if name in files or not src.is_file():
+                continue
+            data = src.read_bytes()
+            if name.endswith(".pbrt"):
+                toks = pbrt_normalize(data)
+                if name == "scene.pbrt":
+                    toks = pbrt_tokens(PBRT_FILM) + toks
+                data = pbrt_join(toks)
+                for r in pbrt_refs(data):
+                    if not os.path.isabs(r) and "/" not in r:
+                        todo.append((src.parent / r, r))
+            files[name] = data
+        if "mesh.ply" in files:
+            files["plain.ply.gz"] = files["mesh.ply"]  # not gzip data despite the name
+        seeds.append((p, files))
+    return seeds
+
+
+def directive_spans(toks):
+    """[(start, end)] of each directive with its arguments."""
+    starts = [k for k, t in enumerate(toks) if is_directive(t)]
+    return [(s, e) for s, e in zip(starts, starts[1:] + [len(toks)])]
+
+
+def bracket_lists(toks):
+    """[(open, close)] index pairs of every [ ... ] without nested brackets."""
+    out, open_at = [], None
+    for k, t in enumerate(toks):
+        if t == b"[":
+            open_at = k
+        elif t == b"]" and open_at is not None:
+            out.append((open_at, k))
+            open_at = None
+    return out
+
+
+def param_values(toks, decl_re):
+    """Token indices of the values of every parameter whose declaration matches decl_re."""
+    out = []
+    for k, t in enumerate(toks):
+        if t.startswith(b'"') and re.fullmatch(decl_re, t.strip(b'"')):
+            if k + 1 < len(toks) and toks[k + 1] == b"[":
+                j = k + 2
+                idx = []
+                while j < len(toks) and toks[j] != b"]":
+                    idx.append(j)
+                    j += 1
+                out.append(idx)
+            elif k + 1 < len(toks):
+                out.append([k + 1])
+    return [o for o in out if o]
+
+
+def pbrt_mutation(rng, toks, m, name):
+    """One token-level mutation of the pbrt file `name` (its token list, changed in place)."""
+    if not toks:
+        toks.append(b"WorldBegin")
+    c = weighted(rng, [("drop", 6), ("dup", 4), ("swap", 4), ("number", 12), ("numbers", 4),
+                       ("bracket", 5), ("insert", 14), ("string", 5), ("ptype", 6), ("pname", 3),
+                       ("array", 8), ("indices", 5), ("directive", 7), ("plyname", 3)])
+    spans = directive_spans(toks)
+    world = [s for s, _ in spans if toks[s] not in (b"Film", b"Sampler", b"Camera", b"LookAt")]
+    if c == "drop":
+        k = rng.randrange(len(toks))
+        m.ops.append(f"{name}: drop token {k} {toks[k][:40]!r}")
+        del toks[k]
+    elif c == "dup":
+        k = rng.randrange(len(toks))
+        toks.insert(k, toks[k])
+        m.ops.append(f"{name}: duplicate token {k} {toks[k][:40]!r}")
+    elif c == "swap":
+        if len(toks) < 2:
+            return False
+        k = rng.randrange(len(toks) - 1)
+        toks[k], toks[k + 1] = toks[k + 1], toks[k]
+        m.ops.append(f"{name}: swap tokens {k} {toks[k + 1][:30]!r} and {toks[k][:30]!r}")
+    elif c in ("number", "numbers"):
+        nums = [k for k, t in enumerate(toks) if is_pbrt_number(t)]
+        if not nums:
+            return False
+        v = rng.choice(PBRT_EXTREMES).encode()
+        if c == "number":
+            k = rng.choice(nums)
+            m.ops.append(f"{name}: number {k} {toks[k]!r} -> {v!r}")
+            toks[k] = v
+        else:
+            with_numbers = [(a, b) for a, b in spans if any(a <= k < b for k in nums)]
+            s, e = rng.choice(with_numbers or spans)
+            for k in range(s, e):
+                if is_pbrt_number(toks[k]):
+                    toks[k] = v
+            m.ops.append(f"{name}: every number of {toks[s][:30]!r} (token {s}) -> {v!r}")
+    elif c == "bracket":
+        k = rng.randrange(len(toks) + 1)
+        what = rng.choice([b"[", b"]", b'"', b'"x', b"[[", b"]]"])
+        if what == b'"' and rng.random() < 0.5:
+            strs = [j for j, t in enumerate(toks) if t.startswith(b'"') and len(t) > 1]
+            if strs:
+                j = rng.choice(strs)
+                toks[j] = toks[j][:-1]
+                m.ops.append(f"{name}: unterminated string at token {j}")
+                return True
+        toks.insert(k, what)
+        m.ops.append(f"{name}: insert {what!r} at token {k}")
+    elif c == "insert":
+        ins = rng.choice(PBRT_INSERTS)
+        s = rng.choice(world) if world and rng.random() < 0.8 else rng.randrange(len(toks) + 1)
+        toks[s:s] = pbrt_tokens(ins.encode("latin-1"))
+        m.ops.append(f"{name}: insert {ins[:60]!r} at token {s}")
+    elif c == "string":
+        strs = [j for j, t in enumerate(toks) if t.startswith(b'"')]
+        if not strs:
+            return False
+        j = rng.choice(strs)
+        v = rng.choice(LONG_STRINGS)
+        toks[j] = b'"' + v + b'"'
+        m.ops.append(f"{name}: string {j} -> {v[:30]!r} ({len(v)} chars)")
+    elif c in ("ptype", "pname"):
+        decls = [j for j, t in enumerate(toks) if re.fullmatch(rb'"\w+ +\w+"', t)]
+        if not decls:
+            return False
+        j = rng.choice(decls)
+        ty, nm = toks[j].strip(b'"').split()
+        if c == "ptype":
+            new = rng.choice(PBRT_TYPES).encode() + b" " + nm
+        else:
+            new = rng.choice([ty + b" " + nm + b"x", ty, ty + b" " + nm + b" extra", b"",
+                              b" " + ty + b"  " + nm + b" ", ty + b" " + nm.upper(),
+                              ty + b" " + rng.choice([b"L", b"I", b"P", b"indices", b"radius",
+                                                      b"filename", b"scale", b"from", b"to"])])
+        m.ops.append(f"{name}: parameter {toks[j]!r} -> {new!r}")
+        toks[j] = b'"' + new + b'"'
+    elif c == "array":
+        lists = bracket_lists(toks)
+        if not lists:
+            return False
+        o, cl = rng.choice(lists)
+        what = rng.randrange(6)
+        if what == 0:
+            del toks[o + 1:cl]
+            m.ops.append(f"{name}: empty the list at token {o}")
+        elif what == 1 and cl > o + 1:
+            k = rng.randrange(o + 1, cl)
+            del toks[k]
+            m.ops.append(f"{name}: drop element {k - o - 1} of the list at token {o}")
+        elif what == 2:
+            toks.insert(cl, rng.choice([b"1", b"0", b"-1", b'"a"', b"true"]))
+            m.ops.append(f"{name}: add an element to the list at token {o}")
+        elif what == 3:
+            body = toks[o + 1:cl]
+            toks[o + 1:cl] = body * rng.choice([2, 3, 100])
+            m.ops.append(f"{name}: repeat the list at token {o}")
+        elif what == 4:
+            toks[o:cl + 1] = [rng.choice([b"1", b'"x"', b"true", b"[", b"]"])]
+            m.ops.append(f"{name}: replace the list at token {o} by one token")
+        else:
+            toks[o:cl + 1] = [t for t in toks[o + 1:cl]]
+            m.ops.append(f"{name}: drop the brackets of the list at token {o}")
+    elif c == "indices":
+        vals = param_values(toks, rb"integer +indices")
+        if not vals:
+            return False
+        idx = rng.choice(vals)
+        k = rng.choice(idx)
+        v = rng.choice([b"-1", b"999999", b"2147483647", b"2147483648", b"4294967296", b"1.5",
+                        b"1e3", str(len(idx)).encode(), b"nan"])
+        m.ops.append(f"{name}: index token {k} {toks[k]!r} -> {v!r}")
+        toks[k] = v
+    elif c == "directive":
+        if not spans:
+            return False
+        s, e = rng.choice(spans)
+        what = rng.randrange(4)
+        block = toks[s:e]
+        if what == 0:
+            del toks[s:e]
+            m.ops.append(f"{name}: delete directive {block[0][:30]!r} at token {s}")
+        elif what == 1:
+            n = rng.choice([2, 2, 10, 50])
+            toks[s:e] = block * n
+            m.ops.append(f"{name}: directive {block[0][:30]!r} at token {s} x {n}")
+        elif what == 2:
+            del toks[s:e]
+            k = rng.choice([sp[0] for sp in directive_spans(toks)] + [len(toks)])
+            toks[k:k] = block
+            m.ops.append(f"{name}: move directive {block[0][:30]!r} from token {s} to {k}")
+        else:
+            toks[s:e] = [toks[s]] + block[1:][:rng.randrange(max(1, e - s - 1))]
+            m.ops.append(f"{name}: cut the arguments of {block[0][:30]!r} at token {s}")
+    else:
+        fns = [v[0] for v in param_values(toks, rb"string +filename")]
+        if not fns:
+            return False
+        k = rng.choice(fns)
+        v = rng.choice(PLY_NAMES)
+        m.ops.append(f"{name}: filename {toks[k][:40]!r} -> {v[:40]!r}")
+        toks[k] = b'"' + v.encode() + b'"'
+    return True
+
+
+def pbrt_too_heavy(data):
+    """A legal film of more than PBRT_MAX_PIXELS (the last Film directive of scene.pbrt)."""
+    toks = pbrt_tokens(data)
+    films = [(s, e) for s, e in directive_spans(toks) if toks[s] == b"Film"]
+    size = {b"xresolution": 1280.0, b"yresolution": 720.0}
+    if films:
+        s, e = films[-1]
+        for k in range(s, e):
+            m = re.fullmatch(rb'"integer +(xresolution|yresolution)"', toks[k])
+            if m:
+                vals = [t for t in toks[k + 1:e] if t not in (b"[",)][:1]
+                try:
+                    size[m.group(1)] = float(vals[0])
+                except (IndexError, ValueError):
+                    return False
+    w, h = size[b"xresolution"], size[b"yresolution"]
+    if not (0 < w <= FILM_CAP and 0 < h <= FILM_CAP):
+        return False
+    return w * h > PBRT_MAX_PIXELS
+
+
+# ------------------------------------------------------------------ PLY files
+PLY_SCALARS = {"char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h", "int16": "h",
+               "ushort": "H", "uint16": "H", "int": "i", "int32": "i", "uint": "I", "uint32": "I",
+               "float": "f", "float32": "f", "double": "d", "float64": "d"}
+PLY_FORMATS = ["ascii", "binary_little_endian", "binary_big_endian"]
+PLY_BAD_TYPES = ["float16", "int64", "uint64", "string", "", "list", "FLOAT", "float float"]
+PLY_BAD_VALUES = ["nan", "-nan", "inf", "-inf", "1e39", "-1e39", "3e38", "1e999", "-1", "999999",
+                  "255", "256", "2147483648", "4294967296", "-2147483649", "abc", "", "1.5",
+                  "0x10", "1e", "+", "1,5"]
+
+
+def ply_split(data):
+    """(header lines, body bytes); header None when there is no end_header line."""
+    k = data.find(b"end_header")
+    if k < 0:
+        return None, data
+    nl = data.find(b"\n", k)
+    end = len(data) if nl < 0 else nl + 1
+    return data[:end].decode("latin-1").split("\n")[:-1] if nl >= 0 else \
+        data[:end].decode("latin-1").split("\n"), data[end:]
+
+
+def ply_parse(data):
+    """(format, [(element, count, [(name, list count type or None, type)])], rows per element)
+    of a well-formed PLY file (the seeds); rows are lists of values (lists for list properties)."""
+    lines, body = ply_split(data)
+    fmt, elems = None, []
+    for l in lines:
+        p = l.split()
+        if p[:1] == ["format"]:
+            fmt = p[1]
+        elif p[:1] == ["element"]:
+            elems.append((p[1], int(p[2]), []))
+        elif p[:1] == ["property"]:
+            elems[-1][2].append((p[-1], p[2], p[3]) if p[1] == "list" else (p[-1], None, p[1]))
+    rows = []
+    if fmt == "ascii":
+        vals, pos = body.split(), 0
+        for _, n, props in elems:
+            er = []
+            for _ in range(n):
+                row = []
+                for _, lt, ty in props:
+                    if lt:
+                        c = int(vals[pos])
+                        row.append([float(x) for x in vals[pos + 1:pos + 1 + c]])
+                        pos += 1 + c
+                    else:
+                        row.append(float(vals[pos]))
+                        pos += 1
+                er.append(row)
+            rows.append(er)
+    else:
+        end, pos = "<" if fmt == "binary_little_endian" else ">", 0
+
+        def rd(ty):
+            nonlocal pos
+            f = end + PLY_SCALARS[ty]
+            v = struct.unpack_from(f, body, pos)[0]
+            pos += struct.calcsize(f)
+            return v
+        for _, n, props in elems:
+            er = []
+            for _ in range(n):
+                row = []
+                for _, lt, ty in props:
+                    row.append([rd(ty) for _ in range(rd(lt))] if lt else rd(ty))
+                er.append(row)
+            rows.append(er)
+    return fmt, elems, rows
+
+
+def ply_pack(end, code, x):
+    """x as the binary PLY scalar `code`; an integer out of range wraps like a C cast."""
+    if code in "fd":
+        return struct.pack(end + code, float(x))
+    bits = struct.calcsize(code) * 8
+    x = int(x) if not (isinstance(x, float) and (math.isnan(x) or math.isinf(x))) else 0
+    lo = -(1 << (bits - 1)) if code.islower() else 0
+    return struct.pack(end + code, (x - lo) % (1 << bits) + lo)
+
+
+def ply_write(fmt, elems, rows):
+    h = [f"ply", f"format {fmt} 1.0"]
+    for (name, n, props), er in zip(elems, rows):
+        h.append(f"element {name} {len(er)}")
+        for pn, lt, ty in props:
+            h.append(f"property list {lt} {ty} {pn}" if lt else f"property {ty} {pn}")
+    h.append("end_header")
+    out = bytearray(("\n".join(h) + "\n").encode())
+    for (_, _, props), er in zip(elems, rows):
+        for row in er:
+            if fmt == "ascii":
+                parts = []
+                for (_, lt, ty), v in zip(props, row):
+                    vs = v if lt else [v]
+                    if lt:
+                        parts.append(str(len(vs)))
+                    parts += [repr(x) if isinstance(x, float) and not x.is_integer() else
+                              str(int(x)) if not (isinstance(x, float) and (math.isnan(x) or math.isinf(x)))
+                              else str(x) for x in vs]
+                out += (" ".join(parts) + "\n").encode()
+            else:
+                end = "<" if fmt == "binary_little_endian" else ">"
+                for (_, lt, ty), v in zip(props, row):
+                    vs = v if lt else [v]
+                    if lt:
+                        out += ply_pack(end, PLY_SCALARS[lt], len(vs))
+                    for x in vs:
+                        out += ply_pack(end, PLY_SCALARS[ty], x)
+    return bytes(out)
+
+
+def ply_model_mutation(rng, data, m, name):
+    """Re-encodes a (seed) PLY file, consistently, in another format and/or with bad values."""
+    try:
+        fmt, elems, rows = ply_parse(data)
+    except Exception:
+        return None
+    fmt2 = rng.choice(PLY_FORMATS)
+    what = []
+    if fmt2 != fmt:
+        what.append(f"as {fmt2}")
+    elems = [(n, c, list(props)) for n, c, props in elems]
+    for _ in range(rng.choice([0, 1, 1, 2])):
+        ei = rng.randrange(len(elems))
+        en, _, props = elems[ei]
+        er = rows[ei]
+        if not er or not props:
+            continue
+        r, pi = rng.randrange(len(er)), rng.randrange(len(props))
+        pn, lt, ty = props[pi]
+        if lt:
+            c = rng.randrange(5)
+            if c == 0:
+                er[r][pi] = []
+            elif c == 1:
+                er[r][pi] = er[r][pi][:rng.choice([1, 2])]
+            elif c == 2:
+                er[r][pi] = er[r][pi] * rng.choice([2, 64, 300])
+            elif c == 3 and er[r][pi]:
+                er[r][pi][rng.randrange(len(er[r][pi]))] = rng.choice(
+                    [-1, len(rows[0]), 999999, 2 ** 31 - 1, 2 ** 31, 2 ** 32 - 1])
+            else:
+                props[pi] = (pn, rng.choice(["uchar", "char", "ushort", "int", "uint", "float"]),
+                             rng.choice(["int", "uint", "uchar", "short", "float", "double"]))
+                what.append(f"{en}.{pn} as list {props[pi][1]} {props[pi][2]}")
+            what.append(f"{en} {r}.{pn} = {er[r][pi][:8]}")
+        else:
+            v = rng.choice([math.nan, math.inf, -math.inf, 3e38, 1e38, -1e30, 1e-45, 0.0, 1e19])
+            er[r][pi] = v
+            if PLY_SCALARS.get(ty, "f") not in "fd" and not rng.random() < 0.5:
+                props[pi] = (pn, None, "double")
+            what.append(f"{en} {r}.{pn} = {v}")
+    if rng.random() < 0.2:
+        ei = rng.randrange(len(elems))
+        rows[ei] = rows[ei] * rng.choice([0, 2])
+        what.append(f"{elems[ei][0]}: {len(rows[ei])} rows")
+    out = ply_write(fmt2, elems, rows)
+    m.ops.append(f"{name}: re-encoded {', '.join(what) or 'unchanged'}")
+    return out
+
+
+def ply_header_mutation(rng, data, m, name):
+    lines, body = ply_split(data)
+    if lines is None:
+        return None
+    els = [i for i, l in enumerate(lines) if l.startswith("element ")]
+    props = [i for i, l in enumerate(lines) if l.startswith("property ")]
+    lists = [i for i in props if lines[i].split()[1:2] == ["list"]]
+    c = rng.randrange(10)
+    if c == 0 and els:
+        i = rng.choice(els)
+        p = lines[i].split()
+        n = int(p[2]) if p[2].isdigit() else 1
+        p[2] = str(rng.choice([0, n - 1, n + 1, 2 * n, 2 ** 31, 2 ** 32 + n, 2 ** 64, -1, -n,
+                               "abc", "1e3", 10 ** 9, 1, ""]))
+        lines[i] = " ".join(p)
+    elif c == 1 and props:
+        i = rng.choice(props)
+        p = lines[i].split()
+        k = rng.randrange(1, len(p) - 1) if len(p) > 2 else 1
+        if p[k] != "list":
+            p[k] = rng.choice(list(PLY_SCALARS) + PLY_BAD_TYPES)
+        lines[i] = " ".join(p)
+    elif c == 2 and lists:
+        i = rng.choice(lists)
+        p = lines[i].split()
+        p[2], p[3] = rng.choice([("int", "int"), ("float", "int"), ("uchar", "float"),
+                                 ("char", "int"), ("ushort", "uint"), ("uchar", "double"),
+                                 ("uint", "uchar"), ("double", "double"), ("uchar", "list")])
+        lines[i] = " ".join(p)
+    elif c == 3:
+        fi = [i for i, l in enumerate(lines) if l.startswith("format")]
+        new = rng.choice(["format " + f + " 1.0" for f in PLY_FORMATS] + [
+            "format ascii 2.0", "format binary_little_endian", "format", "format binary_middle_endian 1.0",
+            "format ascii 1.0 extra", "FORMAT ascii 1.0"])
+        if fi:
+            lines[fi[0]] = new
+        else:
+            lines.insert(1, new)
+        if rng.random() < 0.2 and fi:
+            del lines[fi[0]]
+            new = "(deleted)"
+        m.ops.append(f"{name}: format line -> {new!r}")
+        return ("\n".join(lines) + "\n").encode("latin-1") + body
+    elif c == 4:
+        ei = [i for i, l in enumerate(lines) if l.strip() == "end_header"]
+        what = rng.randrange(3)
+        if what == 0:
+            del lines[ei[0]]
+        elif what == 1:
+            lines[ei[0]] = rng.choice(["end_heade", "end_header x", "END_HEADER", "endheader"])
+        else:
+            lines.insert(ei[0], "end_header")
+    elif c == 5 and props:
+        i = rng.choice(props)
+        lines.insert(i, lines[i]) if rng.random() < 0.6 else lines.pop(i)
+    elif c == 6 and len(els) > 1:
+        # the face element (with its properties) before the vertex element
+        blocks, cur = [], None
+        head = [l for l in lines[:els[0]]]
+        for l in lines[els[0]:-1]:
+            if l.startswith("element "):
+                cur = [l]
+                blocks.append(cur)
+            else:
+                cur.append(l)
+        rng.shuffle(blocks)
+        lines = head + [l for b in blocks for l in b] + ["end_header"]
+    elif c == 7:
+        at = rng.randrange(2, len(lines))
+        lines[at:at] = rng.choice([["element extra 3", "property float a"], ["element extra 0"],
+                                   ["element vertex 1", "property float x"],
+                                   ["property float w"], ["element face 1"],
+                                   ["comment " + "c" * 10000], ["comment a\x00b\xff"],
+                                   ["obj_info x"], [""], ["   "], ["bogus line"]])
+    elif c == 8:
+        first = rng.choice(["PLY", "ply ", "", "plyx", "\xef\xbb\xbfply"])
+        lines[0] = first
+    elif c == 9:
+        m.ops.append(f"{name}: CRLF header")
+        return ("\r\n".join(lines) + "\r\n").encode("latin-1") + body
+    else:
+        return None
+    m.ops.append(f"{name}: header -> {' | '.join(lines)[:150]!r}")
+    return ("\n".join(lines) + "\n").encode("latin-1") + body
+
+
+def ply_body_mutation(rng, data, m, name):
+    lines, body = ply_split(data)
+    hlen = len(data) - len(body)
+    c = rng.randrange(5)
+    if c == 0:
+        cut = rng.randrange(len(data) + 1) if rng.random() < 0.2 else hlen + rng.randrange(len(body) + 1)
+        m.ops.append(f"{name}: truncate at byte {cut} of {len(data)} (body at {hlen})")
+        return data[:cut]
+    data = bytearray(data)
+    if c == 1 and body:
+        n = rng.randint(1, 8)
+        for _ in range(n):
+            data[hlen + rng.randrange(len(body))] = rng.randrange(256)
+        m.ops.append(f"{name}: flip {n} body bytes")
+    elif c == 2:
+        extra = rng.choice([b"\n", b"\x00" * 7, b"1 2 3\n", bytes(range(256))])
+        data += extra
+        m.ops.append(f"{name}: append {len(extra)} bytes")
+    elif c == 3 and b"ascii" in data[:hlen]:
+        toks = [mt.span() for mt in re.finditer(rb"\S+", bytes(data[hlen:]))]
+        if not toks:
+            return None
+        a, b = rng.choice(toks)
+        v = rng.choice(PLY_BAD_VALUES).encode()
+        data[hlen + a:hlen + b] = v
+        m.ops.append(f"{name}: ascii value at byte {hlen + a} -> {v!r}")
+    elif body:
+        a = rng.randrange(len(body))
+        b = min(len(body), a + rng.randint(1, 16))
+        del data[hlen + a:hlen + b]
+        m.ops.append(f"{name}: delete body bytes {a}..{b}")
+    else:
+        return None
+    return bytes(data)
+
+
+def gzip_bytes(data):
+    buf = io.BytesIO()
+    with gzip.GzipFile(filename="", mode="wb", fileobj=buf, mtime=0) as g:
+        g.write(data)
+    return buf.getvalue()
+
+
+def gzip_mutation(rng, gz, m, name):
+    c = rng.randrange(7)
+    d = bytearray(gz)
+    if c == 0:
+        cut = rng.randrange(len(gz))
+        m.ops.append(f"{name}: gzip truncated at byte {cut} of {len(gz)}")
+        return gz[:cut]
+    if c == 1:
+        n = rng.randint(1, 4)
+        for _ in range(n):
+            d[rng.randrange(10, len(d) - 8)] = rng.randrange(256)
+        m.ops.append(f"{name}: gzip: {n} deflate bytes flipped")
+    elif c == 2:
+        k = len(d) - rng.randint(1, 8)
+        d[k] ^= 0xFF
+        m.ops.append(f"{name}: gzip trailer (CRC / size) byte {k} changed")
+    elif c == 3:
+        extra = rng.choice([gz, b"\x1f\x8b", b"garbage", b"\x00" * 8, gzip_bytes(b"")])
+        d += extra
+        m.ops.append(f"{name}: gzip: {len(extra)} bytes after the member")
+    elif c == 4:
+        d = bytearray(rng.choice([b"", b"\x1f\x8b", gz[:10], gzip_bytes(b""),
+                                  gzip_bytes(b"ply\nformat ascii 1.0\nend_header\n")]))
+        m.ops.append(f"{name}: gzip: replaced by {bytes(d)[:12]!r} ({len(d)} bytes)")
+    elif c == 5:
+        d[3] |= rng.choice([0x04, 0x08, 0x10, 0x02, 0xE0])  # FEXTRA/FNAME/FCOMMENT/FHCRC/reserved
+        m.ops.append(f"{name}: gzip flags {d[3]:#x}")
+    else:
+        d[2] = rng.choice([0, 7, 9, 255])
+        m.ops.append(f"{name}: gzip method {d[2]}")
+    return bytes(d)
+
+
+def ply_mutation(rng, files, m):
+    """Mutates one PLY file of the mutant (plain or gzip)."""
+    plys = sorted(n for n in files if n.endswith((".ply", ".ply.gz")) and n != "plain.ply.gz")
+    if not plys:
+        return False
+    name = rng.choice(plys)
+    data = files[name]
+    gz = name.endswith(".gz")
+    if gz and rng.random() < 0.4:
+        files[name] = gzip_mutation(rng, data, m, name)
+        return True
+    if gz:
+        data = gzip.decompress(data)
+    out = None
+    for _ in range(rng.choice([1, 1, 2])):
+        c = rng.randrange(10)
+        fn = ply_header_mutation if c < 4 else ply_body_mutation if c < 7 else \
+            ply_model_mutation if c < 9 else None
+        if fn:
+            # The second mutation may meet a header the first broke: then it does nothing.
+            try:
+                new = fn(rng, data, m, name)
+            except (ValueError, IndexError, KeyError, struct.error):
+                new = None
+        else:
+            new = b_mutate(rng, data, m)
+            m.ops[-1] = f"{name}: bytes: {m.ops[-1]}"
+        if new is not None:
+            data = out = new
+    if out is None:
+        return False
+    files[name] = gzip_bytes(out) if gz else out
+    return True
+
+
+def make_pbrt_mutant(rng, ident, pbrt_seeds, cat):
+    for _attempt in range(50):
+        if cat == "ply":
+            cands = [s for s in pbrt_seeds if any(n.endswith((".ply", ".gz")) for n in s[1])]
+        else:
+            cands = pbrt_seeds
+        seed_path, seed_files = rng.choice(cands)
+        m = Mutant(ident, seed_path)
+        m.kind = cat
+        m.scene_arg = "scene.pbrt"
+        m.pbrt = True
+        files = dict(seed_files)
+        ok = False
+        if cat == "ply":
+            ok = ply_mutation(rng, files, m)
+            if ok and rng.random() < 0.1:
+                cat = "pbrt"  # and a pbrt mutation too
+        if cat == "pbrt":
+            names = sorted(n for n in files if n.endswith(".pbrt"))
+            for _ in range(rng.choice([1, 1, 1, 2, 3])):
+                name = "scene.pbrt" if rng.random() < 0.6 else rng.choice(names)
+                if rng.random() < 0.12:
+                    files[name] = b_mutate(rng, files[name], m)
+                    m.ops[-1] = f"{name}: bytes: {m.ops[-1]}"
+                    ok = True
+                    continue
+                toks = pbrt_tokens(files[name])
+                if pbrt_mutation(rng, toks, m, name):
+                    files[name] = pbrt_join(toks)
+                    ok = True
+        if not ok or pbrt_too_heavy(files["scene.pbrt"]):
+            continue
+        m.files = files
+        return m
+    raise RuntimeError(f"mutant {ident}: no applicable pbrt mutation in 50 attempts")
+
+
+def pbrt_special_cases():
+    """Special files of a pbrt scene: the scene, an Include and a PLY file that are not regular
+    files, missing, empty or loops; each must give exit 2 and one line."""
+    seed = dict(load_pbrt_seeds()[-1][1])  # tests/fuzz/scene.pbrt (sorted last)
+    cases = []
+
+    def case(kind, files=None, setup=(), drop=(), arg="scene.pbrt", expect=True):
+        f = dict(seed)
+        f.update(files or {})
+        for d in drop:
+            f.pop(d, None)
+        cases.append((kind, arg, f, list(setup), [], None, expect))
+
+    case("pbrt scene-fifo", drop=["scene.pbrt"], setup=[("fifo", "scene.pbrt", None)])
+    case("pbrt scene-directory", drop=["scene.pbrt"], setup=[("dir", "scene.pbrt", None)])
+    case("pbrt scene-missing", arg="missing.pbrt")
+    case("pbrt scene-symlink-dev-zero", drop=["scene.pbrt"],
+         setup=[("symlink", "scene.pbrt", "/dev/zero")])
+    case("pbrt scene-empty", files={"scene.pbrt": b""}, expect=False)
+    for inc, kinds in [("scene-inc.pbrt", "fifo dev-zero directory missing loop empty"),
+                       ("mesh.ply", "fifo dev-zero directory missing empty"),
+                       ("mesh_be.ply", "missing empty"), ("mesh_le.ply.gz", "fifo dev-zero empty")]:
+        kinds = kinds.split()
+        if "fifo" in kinds:
+            case(f"pbrt {inc}-fifo", drop=[inc], setup=[("fifo", inc, None)])
+        if "dev-zero" in kinds:
+            case(f"pbrt {inc}-dev-zero", drop=[inc], setup=[("symlink", inc, "/dev/zero")])
+        if "directory" in kinds:
+            case(f"pbrt {inc}-directory", drop=[inc], setup=[("dir", inc, None)])
+        if "missing" in kinds:
+            case(f"pbrt {inc}-missing", drop=[inc])
+        if "loop" in kinds:
+            case(f"pbrt {inc}-symlink-loop", drop=[inc],
+                 setup=[("symlink", inc, "loop"), ("symlink", "loop", inc)])
+        if "empty" in kinds:  # an empty included file is an empty scene part, not an error
+            case(f"pbrt {inc}-empty", files={inc: b""}, expect=not inc.endswith(".pbrt"))
+    return cases
+
+
 # ------------------------------------------------------------------ mutant generation
 CATEGORIES = [("json", 55), ("bytes", 15), ("obj", 30)]
+# The share of pbrt-v4 mutants (a pbrt file mutated, or a PLY file it references) among the
+# random ones; --formats json / pbrt leaves the other out (mutant i of a --formats pbrt run is
+# mutant i of a full run whenever that one is a pbrt mutant).
+FORMATS = [("json", 70), ("pbrt", 30)]
+PBRT_CATEGORIES = [("pbrt", 65), ("ply", 35)]
 
 
 def weighted(rng, items):
@@ -898,9 +1698,9 @@ def weighted(rng, items):
     return items[-1][0]
 
 
-def make_mutant(ident, base_seed, seeds, specials):
+def make_mutant(ident, base_seed, seeds, specials, pbrt_seeds, formats):
     if ident < len(specials):
-        kind, arg, files, setup, args, names = specials[ident]
+        kind, arg, files, setup, args, names, *expect = specials[ident]
         m = Mutant(ident, None)
         m.kind = "cli" if kind.startswith("cli ") else "special"
         m.ops.append(kind)
@@ -909,9 +1709,15 @@ def make_mutant(ident, base_seed, seeds, specials):
         m.setup = setup
         m.args = args
         m.names = names
-        m.expect_error = kind.startswith(("scene-", "obj-", "mtl-", "cli "))
+        m.pbrt = kind.startswith("pbrt ")
+        m.expect_error = expect[0] if expect else kind.startswith(("scene-", "obj-", "mtl-", "cli "))
         return m
     rng = random.Random(f"{base_seed}/{ident}")
+    # The format from a stream of its own: a JSON mutant i is the one it was before pbrt mutants
+    # existed, a pbrt mutant i the same in a --formats pbrt run.
+    fmt_rng = random.Random(f"{base_seed}/{ident}/format")
+    if weighted(fmt_rng, [f for f in FORMATS if f[0] in formats]) == "pbrt":
+        return make_pbrt_mutant(rng, ident, pbrt_seeds, weighted(rng, PBRT_CATEGORIES))
     for _attempt in range(50):
         seed_path, seed_tree = rng.choice(seeds)
         m = Mutant(ident, seed_path)
@@ -997,6 +1803,14 @@ def classify(m, rc, timed_out, out, err, wdir, iinfo):
         if m.names is not None:
             if m.names not in text:
                 return False, f"exit 2, message does not name {m.names}", ""
+        elif m.pbrt:
+            # pbrt: "<file>: ..." or "<file>:<line>: ..." where <file> is the scene path as given
+            # or a file of the mutant (an included pbrt file, a PLY file).
+            names = {m.scene_arg} | set(m.files) | {name for _, name, _ in m.setup}
+            hit = re.match(r"(.*?)(:\d+)?: ", text)
+            if not hit or not any(text.startswith(n + ":") and hit.group(1) == n for n in names
+                                  if printable(n)):
+                return False, "exit 2, message does not begin with a file of the scene", ""
         elif printable(m.scene_arg) and not text.startswith(m.scene_arg + ": "):
             return False, "exit 2, message does not name the file", ""
         return True, "ok: one-line error", ""
@@ -1138,6 +1952,9 @@ def summarize(results):
         op = r["ops"][0].split()[0] if r["kind"] == "special" else (
             "bytes" if r["kind"] == "bytes" else
             r["kind"] + ":" + (r["ops"][0].split()[0].rstrip(":") if r["kind"] == "json" and r["ops"] else ""))
+        if r["kind"] in ("pbrt", "ply") and r["ops"]:
+            words = r["ops"][0].split()
+            op = r["kind"] + ":" + (words[1].rstrip(":") if len(words) > 1 else "")
         if r["kind"] == "obj":
             op = "obj/mtl"
         if r["kind"] == "special":
@@ -1185,6 +2002,8 @@ def main():
     ap.add_argument("--no-heavy", action="store_true",
                     help=f"leave out the slow seeds ({', '.join(sorted(HEAVY_SEEDS))})")
     ap.add_argument("--no-special", action="store_true", help="leave out the special-file cases")
+    ap.add_argument("--formats", choices=["all", "json", "pbrt"], default="all",
+                    help="mutate JSON scenes (with OBJ/MTL), pbrt-v4 scenes (with PLY) or both")
     ap.add_argument("--only", type=int, action="append", help="run only mutant ID (repeatable)")
     ap.add_argument("--keep", action="store_true", help="keep passing mutants too (OUT/passed)")
     ap.add_argument("--list", action="store_true", help="print the mutations, run nothing")
@@ -1207,9 +2026,13 @@ def main():
             args.mem_limit_mb = 0
 
     seeds = load_seeds(not args.no_heavy)
-    specials = [] if args.no_special else special_cases()
+    pbrt_seeds = load_pbrt_seeds()
+    formats = ["json", "pbrt"] if args.formats == "all" else [args.formats]
+    specials = [] if args.no_special else (
+        (special_cases() if "json" in formats else []) +
+        (pbrt_special_cases() if "pbrt" in formats else []))
     ids = args.only if args.only else list(range(args.count))
-    mutants = [make_mutant(i, args.seed, seeds, specials) for i in ids]
+    mutants = [make_mutant(i, args.seed, seeds, specials, pbrt_seeds, formats) for i in ids]
     if args.list:
         for m in mutants:
             seed = m.seed.relative_to(ROOT) if m.seed else "-"
@@ -1221,7 +2044,7 @@ def main():
     for d in (work, failures, outdir / "passed"):
         shutil.rmtree(d, ignore_errors=True)
     work.mkdir(parents=True)
-    print(f"fuzz: {len(mutants)} mutants from {len(seeds)} seeds, --seed {args.seed}, "
+    print(f"fuzz: {len(mutants)} mutants from {len(seeds) + len(pbrt_seeds)} seeds, --seed {args.seed}, "
           f"{args.jobs} jobs, timeout {args.timeout:g} s, {args.canopy}", flush=True)
 
     t0 = time.monotonic()

@@ -280,16 +280,16 @@ TEST(ScenePly, BrokenFilesAreOneLineErrorsAfterThePrefix) {
       {"cut_in_header.ply", le.substr(0, 40), "not a PLY file or truncated header (no end_header)"},
       {"cut_ascii.ply", ascii.substr(0, ascii.rfind("3 1")),
        "truncated: the file ends in face 2 of 2"},
-      {"garbage.ply", std::string("\x7f\x45LF\x02\x01 garbage\n\x00\x01", 20),
+      {"garbage.ply", std::string("\x7f\x45LF\x02\x01 garbage\n\x00\x01", 17),
        "not a PLY file (it does not start with \"ply\")"},
       {"empty.ply", "", "not a PLY file or truncated header (no end_header)"},
       {"bad_number.ply",
        ascii.substr(0, ascii_body) + "0.1 x 3" + ascii.substr(ascii.find('\n', ascii_body)),
        "line 16: vertex 1 of 5: 'x' is not a number"},
       {"index_out_of_range.ply", ply_bytes(oob, Enc::LittleEndian),
-       "a face has the vertex index 5, out of range [0, 5)"},
+       "face 2 of 2: the vertex index 5 is out of range [0, 5)"},
       {"negative_index.ply", ply_bytes(negative, Enc::Ascii),
-       "a face has the vertex index -1, out of range [0, 5)"},
+       "line 22: face 2 of 2: the vertex index -1 is out of range [0, 5)"},
       {"long_face.ply", ascii.substr(0, ascii.rfind("3 1")) + "2000 1 4 2\n",
        "line 22: face 2 of 2: list \"vertex_indices\" has the length '2000'"},
       {"not_gzip.ply.gz", le, "not a gzip file (the name ends in .gz)"},
@@ -307,6 +307,85 @@ TEST(ScenePly, BrokenFilesAreOneLineErrorsAfterThePrefix) {
   write(d / "cut.ply.gz", gz.substr(0, gz.size() / 2));
   EXPECT_EQ(error_of(d / "cut.ply.gz"), "p: truncated gzip data");
   EXPECT_EQ(error_of(d / "missing.ply"), "p: cannot open file");
+}
+
+// Face indices are checked before Assimp reads the file: its triangulation reads a polygon's
+// vertices by index, so an index far out of range in a quad crashed it (SIGSEGV; found by the
+// fuzzer: a binary file with bytes deleted in its vertices, whose faces then read garbage).
+TEST(ScenePly, OutOfRangeIndicesOfPolygonsAreErrorsBeforeAssimp) {
+  fs::path d = temp_dir();
+  for (Enc enc : {Enc::Ascii, Enc::LittleEndian, Enc::BigEndian})
+    for (int32_t bad : {100000000, -100000000, 5}) {
+      Ply p = kQuadAndTriangle;
+      ASSERT_EQ(p.faces[0].size(), 4u);
+      p.faces[0][2] = bad;
+      write(d / "q.ply", ply_bytes(p, enc));
+      std::string e = error_of(d / "q.ply");
+      EXPECT_NE(e.find("face 1 of 2: the vertex index " + std::to_string(bad) +
+                       " is out of range [0, 5)"),
+                std::string::npos)
+          << e;
+    }
+  // A float index list: 1e999 (out of the double range) and NaN are out of range too.
+  for (const char* bad : {"1e999", "nan", "-0.5e10"}) {
+    std::string a = ply_bytes(kQuadAndTriangle, Enc::Ascii);
+    a.replace(a.find("list uchar int"), 14, "list uchar float");
+    a.replace(a.rfind("4 0 1 2 3"), 9, std::string("4 0 1 ") + bad + " 3");
+    write(d / "f.ply", a);
+    std::string e = error_of(d / "f.ply");
+    EXPECT_NE(e.find(std::string("face 1 of 2: the vertex index ") + bad + " is out of range"),
+              std::string::npos)
+        << e;
+  }
+  // The fuzzer's reproduction: a polygon whose count and indices are vertex bytes.
+  Ply shifted = kQuadAndTriangle;
+  shifted.faces[0] = {0, 1, 2, 3, 4, 0x3e99999a};
+  write(d / "s.ply", ply_bytes(shifted, Enc::BigEndian));
+  EXPECT_NE(error_of(d / "s.ply").find("is out of range [0, 5)"), std::string::npos);
+}
+
+// A control byte in the header is an error: Assimp's header parser and Canopy's would read
+// different layouts (a comment "a\0b" between two vertex properties, "end_header\r\r\n" crashed
+// Assimp; found by the fuzzer).
+TEST(ScenePly, AControlByteInTheHeaderIsAnError) {
+  fs::path d = temp_dir();
+  for (Enc enc : {Enc::Ascii, Enc::LittleEndian, Enc::BigEndian}) {
+    std::string b = ply_bytes(kQuadAndTriangle, enc);
+    const size_t at = b.find("property float z\n");
+    b = b.substr(0, at) + std::string("comment a\0b\xff\n", 13) + b.substr(at);
+    write(d / "nul.ply", b);
+    EXPECT_EQ(error_of(d / "nul.ply"), "p: header line 7: a control byte (0x00)");
+    // A CR before the CRLF of end_header: Assimp started the body one byte early.
+    std::string crcr = ply_bytes(kQuadAndTriangle, enc);
+    crcr.replace(crcr.find("end_header\n"), 11, "end_header\r\r\n");
+    write(d / "crcr.ply", crcr);
+    EXPECT_EQ(error_of(d / "crcr.ply"), "p: header line 15: a control byte (0x0d)");
+    // CRLF lines are fine.
+    const std::string lf = ply_bytes(kQuadAndTriangle, enc);
+    const size_t body = lf.find("end_header\n") + 11;
+    std::string crlf;
+    for (size_t k = 0; k < body; ++k)
+      crlf += lf[k] == '\n' ? std::string("\r\n") : std::string(1, lf[k]);
+    crlf += lf.substr(body);
+    write(d / "crlf.ply", crlf);
+    expect_quad_and_triangle(load(d / "crlf.ply"));
+  }
+}
+
+// Comment, obj_info and blank lines may be anywhere in the header (Assimp 5.2 ended an element's
+// properties at one, read another layout and crashed; found by the fuzzer).
+TEST(ScenePly, CommentsBetweenPropertiesAreRead) {
+  fs::path d = temp_dir();
+  for (Enc enc : {Enc::Ascii, Enc::LittleEndian, Enc::BigEndian}) {
+    std::string b = ply_bytes(kQuadAndTriangle, enc);
+    for (const char* before : {"property float z\n", "element vertex", "property float nx\n",
+                               "property list", "end_header"}) {
+      const size_t at = b.find(before);
+      b = b.substr(0, at) + "obj_info x\ncomment y\n  \n" + b.substr(at);
+    }
+    write(d / "o.ply", b);
+    expect_quad_and_triangle(load(d / "o.ply"));
+  }
 }
 
 // Assimp's logger stays silent (no DefaultLogger is created).

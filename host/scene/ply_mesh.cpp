@@ -117,6 +117,8 @@ struct Header {
   size_t after_first_element = 0; // offset of the line after the first "element" line
   // Offsets of the last letter of the vertex properties "texture_s" and "texture_t" (0: absent).
   size_t texture_s = 0, texture_t = 0;
+  // [begin, end) of each comment, obj_info and blank line (with its line end).
+  std::vector<std::pair<size_t, size_t>> comments;
 };
 
 std::vector<std::string_view> split(std::string_view line) {
@@ -149,12 +151,24 @@ Header parse_header(const std::string& d, const std::string& prefix) {
     auto bad = [&](std::string_view what) {
       fail(prefix, fmt::format("header line {}: {}", line_no, what));
     };
-    if (line_no == 1) {
-      if (t.size() != 1 || (t[0] != "ply" && t[0] != "PLY"))
-        fail(prefix, "not a PLY file (it does not start with \"ply\")");
+    if (line_no == 1 && (t.size() != 1 || (t[0] != "ply" && t[0] != "PLY")))
+      fail(prefix, "not a PLY file (it does not start with \"ply\")");
+    // Assimp's header parser ends a line at a NUL or a CR (and skips the next line after one it
+    // does not know): with a control byte in a line it would read another layout than the one
+    // checked here (a NUL in a comment, "end_header\r\r\n" crashed it). Only a line's last CR
+    // (CRLF) is allowed, and tabs.
+    {
+      std::string_view l = line;
+      if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+      for (char c : l)
+        if ((uint8_t(c) < 0x20 && c != '\t') || uint8_t(c) == 0x7f)
+          bad(fmt::format("a control byte (0x{:02x})", uint8_t(c)));
+    }
+    if (line_no == 1) continue;
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") {
+      h.comments.push_back({size_t(line.data() - d.data()), pos});
       continue;
     }
-    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
     if (t[0] == "end_header") break;
     if (t[0] == "format") {
       if (t.size() != 3) bad("expected \"format <type> <version>\"");
@@ -202,15 +216,36 @@ Header parse_header(const std::string& d, const std::string& prefix) {
   return h;
 }
 
+std::string where(const Element& e, uint64_t i) {
+  return fmt::format("{} {} of {}", printable(e.name, 40), i + 1, e.count);
+}
+
+bool face_indices(const Element& e, const Property& p) {
+  return e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
+}
+
 // A list's length limit: faces as for OBJ (Assimp triangulates in quadratic time); other lists
 // are only skipped over.
 uint64_t max_list(const Element& e, const Property& p) {
-  bool face = e.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
-  return face ? uint64_t(kMaxPolygonVertices) : UINT64_MAX;
+  return face_indices(e, p) ? uint64_t(kMaxPolygonVertices) : UINT64_MAX;
 }
 
-std::string where(const Element& e, uint64_t i) {
-  return fmt::format("{} {} of {}", printable(e.name, 40), i + 1, e.count);
+// The vertex count the header declares (0 without a vertex element; the smallest if there are
+// several, whichever of them Assimp reads).
+uint64_t vertex_count(const Header& h) {
+  uint64_t n = UINT64_MAX;
+  for (const Element& e : h.elements)
+    if (e.name == "vertex") n = std::min(n, e.count);
+  return n == UINT64_MAX ? 0 : n;
+}
+
+// Face indices are checked before Assimp sees them: its triangulation reads the vertices of a
+// polygon by index, so one out of range crashes it.
+void check_index(double v, const Element& e, uint64_t i, uint64_t vertices,
+                 const std::string& prefix) {
+  if (!(v >= 0.0 && v < double(vertices)))
+    fail(prefix, fmt::format("{}: the vertex index {} is out of range [0, {})", where(e, i),
+                             fmt::format("{}", v), vertices));
 }
 
 // The value of a binary integer of type t at p.
@@ -224,8 +259,26 @@ int64_t read_int(const char* p, const ScalarType& t, bool big_endian) {
   return int64_t(u);
 }
 
+// The value of a binary scalar of type t at p, as double.
+double read_value(const char* p, const ScalarType& t, bool big_endian) {
+  if (t.integer) return double(read_int(p, t, big_endian));
+  ScalarType bits = t;
+  bits.is_signed = false;
+  const uint64_t u = uint64_t(read_int(p, bits, big_endian));
+  if (t.size == 4) {
+    float f;
+    const uint32_t u32 = uint32_t(u);
+    std::memcpy(&f, &u32, 4);
+    return double(f);
+  }
+  double v;
+  std::memcpy(&v, &u, 8);
+  return v;
+}
+
 void check_binary(const std::string& d, const Header& h, const std::string& prefix) {
   const bool be = h.format == Format::BinaryBE;
+  const uint64_t vertices = vertex_count(h);
   size_t pos = h.body;
   auto truncated = [&](const Element& e, uint64_t i) {
     fail(prefix, fmt::format("truncated: the file ends in {} ({} bytes)", where(e, i), d.size()));
@@ -255,6 +308,10 @@ void check_binary(const std::string& d, const Header& h, const std::string& pref
           n = uint64_t(c);
         }
         if (n > (d.size() - pos) / uint64_t(p.item.size)) truncated(e, i);
+        if (face_indices(e, p))
+          for (uint64_t j = 0; j < n; ++j)
+            check_index(read_value(d.data() + pos + j * uint64_t(p.item.size), p.item, be), e, i,
+                        vertices, prefix);
         pos += size_t(n * uint64_t(p.item.size));
       }
   }
@@ -277,6 +334,7 @@ bool numeric(std::string_view tok, bool integer, int64_t* value = nullptr) {
 // One element instance per line (blank lines are skipped, as Assimp does); values past the
 // element's properties are ignored, as Assimp does.
 void check_ascii(const std::string& d, const Header& h, const std::string& prefix) {
+  const uint64_t vertices = vertex_count(h);
   size_t pos = h.body;
   int line_no = int(std::count(d.begin(), d.begin() + ptrdiff_t(h.body), '\n'));
   for (const Element& e : h.elements)
@@ -306,10 +364,20 @@ void check_ascii(const std::string& d, const Header& h, const std::string& prefi
           n = uint64_t(c);
         }
         if (n > t.size() - k) bad("too few values");
-        for (uint64_t j = 0; j < n; ++j, ++k)
+        for (uint64_t j = 0; j < n; ++j, ++k) {
           if (!numeric(t[k], p.item.integer))
             bad(fmt::format("'{}' is not a{} number", printable(t[k], 40),
                             p.item.integer ? "n integer" : ""));
+          if (face_indices(e, p)) {
+            std::string_view tok = t[k];
+            if (tok.size() > 1 && tok[0] == '+') tok.remove_prefix(1);
+            double v = 0.0;
+            auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+            if (r.ec != std::errc() || !(v >= 0.0 && v < double(vertices)))
+              bad(fmt::format("the vertex index {} is out of range [0, {})", printable(t[k], 40),
+                              vertices));
+          }
+        }
       }
     }
 }
@@ -323,36 +391,63 @@ void rename_texture_st(std::string& d, const Header& h) {
   d[h.texture_t] = 'v';
 }
 
-// Assimp 5.2's PLY reader skips whitespace after end_header's line even in a binary file, so a
-// body whose first byte is 0x09-0x0d or 0x20 (say, a little-endian float x whose low byte is
-// '\n') is read one or more bytes late: garbage, or an ai_assert abort in its triangulation.
-// Such a file gets a one-byte property "canopy_pad" ('!', not whitespace) before the others of
-// its first element, which must be "vertex" without lists (Assimp ignores unknown properties).
-void pad_binary_body(std::string& d, const Header& h, const std::string& prefix) {
-  if (h.format == Format::Ascii || h.body >= d.size()) return;
-  const char c = d[h.body];
-  if (c != ' ' && (c < '\t' || c > '\r')) return;
-  const Element& e = h.elements.front();
-  bool padded = e.name == "vertex";
+// The file as Assimp 5.2 can read it, worked around two of its bugs:
+// - It ends an element's properties at a comment, obj_info or blank line and then skips the
+//   properties after it (so it read another layout than the one checked and crashed; found by
+//   the fuzzer): those lines are removed from the header.
+// - It skips whitespace after end_header's line even in a binary file, so a body whose first byte
+//   is 0x09-0x0d or 0x20 (say, a little-endian float x whose low byte is '\n') is read one or more
+//   bytes late: garbage, or an ai_assert abort in its triangulation. Such a file gets a one-byte
+//   property "canopy_pad" ('!', not whitespace) before the others of its first element, which
+//   must be "vertex" without lists (Assimp ignores unknown properties).
+void rewrite_for_assimp(std::string& d, const Header& h, const std::string& prefix) {
+  bool pad = false;
   size_t row = 0;
-  for (const Property& p : e.props) {
-    padded = padded && !p.list;
-    row += size_t(p.item.size);
+  const Element& first = h.elements.front();
+  if (h.format != Format::Ascii && h.body < d.size()) {
+    const char c = d[h.body];
+    pad = c == ' ' || (c >= '\t' && c <= '\r');
   }
-  if (!padded || row == 0)
-    fail(prefix, "not read: its binary data starts with a whitespace byte, which Assimp skips "
-                 "(only a first element \"vertex\" without list properties is worked around)");
+  if (pad) {
+    bool ok = first.name == "vertex";
+    for (const Property& p : first.props) {
+      ok = ok && !p.list;
+      row += size_t(p.item.size);
+    }
+    if (!ok || row == 0)
+      fail(prefix, "not read: its binary data starts with a whitespace byte, which Assimp skips "
+                   "(only a first element \"vertex\" without list properties is worked around)");
+  }
+  if (!pad && h.comments.empty()) return;
   std::string out;
-  out.reserve(d.size() + e.count + 32);
-  out.append(d, 0, h.after_first_element);
-  out += "property uchar canopy_pad\n";
-  out.append(d, h.after_first_element, h.body - h.after_first_element);
-  size_t pos = h.body; // check_binary has seen every row
-  for (uint64_t i = 0; i < e.count; ++i, pos += row) {
-    out += '!';
-    out.append(d, pos, row);
+  out.reserve(d.size() + (pad ? first.count + 32 : 0));
+  size_t from = 0, next_comment = 0;
+  // Copies the header up to offset `to`, leaving out the comment lines (whole lines: none
+  // straddles a line boundary such as after_first_element).
+  auto copy_header_until = [&](size_t to) {
+    for (; next_comment < h.comments.size() && h.comments[next_comment].first < to;
+         ++next_comment) {
+      out.append(d, from, h.comments[next_comment].first - from);
+      from = h.comments[next_comment].second;
+    }
+    out.append(d, from, to - from);
+    from = to;
+  };
+  if (pad) {
+    copy_header_until(h.after_first_element);
+    out += "property uchar canopy_pad\n";
   }
-  out.append(d, pos, std::string::npos);
+  copy_header_until(h.body);
+  if (pad) {
+    size_t pos = h.body; // check_binary has seen every row
+    for (uint64_t i = 0; i < first.count; ++i, pos += row) {
+      out += '!';
+      out.append(d, pos, row);
+    }
+    out.append(d, pos, std::string::npos);
+  } else {
+    out.append(d, h.body, std::string::npos);
+  }
   d.swap(out);
 }
 
@@ -384,7 +479,7 @@ PlyMesh load_ply_mesh(const std::filesystem::path& file, const std::string& pref
   // Assimp makes a point cloud of a file without faces; there is nothing to render in it.
   if (vertices == 0 || faces == 0) return out;
   rename_texture_st(data, h);
-  pad_binary_body(data, h, prefix);
+  rewrite_for_assimp(data, h, prefix);
 
   Assimp::Importer importer;
   // Triangulation only: no welding (aiProcess_JoinIdenticalVertices), no generated normals, no
