@@ -222,6 +222,17 @@ TEST(ScenePly, BinaryBodyStartingWithWhitespaceBytesIsReadExactly) {
     PlyMesh m = load(d / "m.ply");
     expect_rows(m, p, true, true);
     expect_quad_and_triangle(m);
+    // Both header rewrites at once: a comment line among the vertex properties (removed) and the
+    // pad property (inserted after the element line, before that comment).
+    std::string commented = bytes;
+    const size_t prop = commented.find("property", commented.find("element vertex"));
+    commented.insert(prop, "comment between the element and its first property\n");
+    const size_t second = commented.find("property", commented.find("property", prop) + 8);
+    commented.insert(second, "obj_info among the properties\n");
+    write(d / "c.ply", commented);
+    PlyMesh c = load(d / "c.ply");
+    expect_rows(c, p, true, true);
+    expect_quad_and_triangle(c);
   }
 }
 
