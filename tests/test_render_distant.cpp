@@ -99,10 +99,8 @@ TEST(DistantLight, SumsWithTheTreeLightsExactly) {
       for (int x = 0; x < film.width; ++x) {
         // The pixel's footprint on the plane at fov 1 degree spans ~4e-3: the point light's term
         // is taken at the footprint's centre and its spread bounds the tolerance.
-        float3 d = normalize(xyz_of(cam.lower_left) + xyz_of(cam.du) * (float(x) + 0.5f) +
-                             xyz_of(cam.dv) * (float(y) + 0.5f));
-        float3 o = xyz_of(cam.origin);
-        float3 X = o + d * (-o.z / d.z);
+        float3 X;
+        test::camera_ray_to_plane(cam, float(x) + 0.5f, float(y) + 0.5f, &X);
         float3 to = pl - X;
         float d2 = dot(to, to);
         float3 E = E1 * -normalize(t1).z + E2 * -normalize(t2).z + I * (to.z / std::sqrt(d2) / d2);

@@ -391,10 +391,8 @@ TEST(EnvironmentRender, SkyAndATreeLightAddUpAtGlossyPoints) {
   double point_term = 0.0; // image mean of the point light's exact radiance at pixel centres
   for (int y = 0; y < probe.film.height; ++y)
     for (int x = 0; x < probe.film.width; ++x) {
-      float3 d = normalize(xyz_of(cam.lower_left) + xyz_of(cam.du) * (float(x) + 0.5f) +
-                           xyz_of(cam.dv) * (float(y) + 0.5f));
-      float3 o = xyz_of(cam.origin);
-      float3 X = o + d * (-o.z / d.z);
+      float3 X;
+      float3 d = test::camera_ray_to_plane(cam, float(x) + 0.5f, float(y) + 0.5f, &X);
       float3 to = pl - X;
       float d2 = dot(to, to);
       float3 wi = to * (1.0f / std::sqrt(d2));

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "bsdf/bsdf.h"
+#include "render/camera.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 
@@ -34,6 +35,15 @@ inline Scene lit_plane_scene(MaterialDesc m, float fov, float half, int width, i
   s.triangle_material = {0, 0};
   s.triangle_light = {-1, -1};
   return s;
+}
+
+// The unit direction of the camera ray through raster point (fx, fy) and where it meets the plane
+// z = 0 (*X).
+inline float3 camera_ray_to_plane(const CameraParams& cam, float fx, float fy, float3* X) {
+  float3 d = normalize(xyz_of(cam.lower_left) + xyz_of(cam.du) * fx + xyz_of(cam.dv) * fy);
+  float3 o = xyz_of(cam.origin);
+  *X = o + d * (-o.z / d.z);
+  return d;
 }
 
 // Renders `scene` with `sampler` at spp (seed 5); no sample may be non-finite.
