@@ -19,6 +19,7 @@
 #define HAS_MATERIAL_CONDUCTOR 1
 #define HAS_MATERIAL_PLASTIC 1
 #define HAS_MEDIUM 1
+#define HAS_TEXTURES 1
 #endif
 
 // MIS between light and BSDF sampling (RendererOptions::mis; off only for the ablation).

@@ -74,8 +74,36 @@ typedef struct Material {
   float alpha;     // conductor, plastic: GGX alpha = roughness^2 (0: perfect specular)
   float ior;       // plastic: index of refraction of the coat
   int type;        // MATERIAL_*
-  int pad;
+  // Image textures (HAS_TEXTURES; cl/texture.h): 1 + the index into the scene's textures of the
+  // texture that replaces albedo (rgb) and alpha (a float texture mapped to alpha, Texture::map);
+  // 0: none, so a zero-initialised Material is untextured.
+  int albedo_texture;
+  int alpha_texture;
+  int pad0, pad1, pad2;
 } Material;
+
+// ---------------------------------------------------------------- image textures
+// An image texture (cl/texture.h): bilinearly filtered texels of one image, looked up at a
+// triangle's interpolated (u, v). The image's row 0 is its top and t = 0 its bottom, as in pbrt-v4
+// and OBJ: texel coordinates are (s w, (1 - t) h) for (s, t) = uvmap applied to (u, v).
+#define TEXTURE_WRAP_REPEAT 0 // s, t taken modulo 1
+#define TEXTURE_WRAP_CLAMP 1  // texel coordinates clamped to the image
+#define TEXTURE_WRAP_BLACK 2  // texels outside the image are 0
+// What a float texture's filtered value r means for GGX alpha (Texture::map; rgb textures: 0).
+#define TEXTURE_MAP_VALUE 0        // the value itself (rgb reflectance, or alpha)
+#define TEXTURE_MAP_ALPHA_SQUARE 1 // Canopy's roughness: alpha = r^2 (scene.h conductor_material)
+#define TEXTURE_MAP_ALPHA_SQRT 2   // pbrt-v4's remapped roughness: alpha = sqrt(r)
+
+typedef struct Texture {
+  float4 scale; // multiplies the filtered value (rgb; a float texture uses x), before `map`
+  float4 uvmap; // (s, t) = (x u + z, y v + w): pbrt-v4's uv mapping su, sv, du, dv
+  int first;    // index in the texel buffer of the first channel of the image's first texel
+  int width, height;
+  int channels; // 3: rgb texels; 1: one float per texel
+  int wrap;     // TEXTURE_WRAP_*
+  int map;      // TEXTURE_MAP_*
+  int pad0, pad1;
+} Texture;
 
 // ---------------------------------------------------------------- participating media
 // A homogeneous medium (docs/scene-format.md "medium"; cl/volume/medium.h): coefficients per scene

@@ -171,6 +171,7 @@ protected:
           make_float4(0, 0, 0, scene_.has_medium && i % 4 == 1 ? VOLUME_POINT_FLAG : 0.0f));
       p.shade_wo.push_back(make_float4(0, 0, 0, 0));
       p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
+      p.shade_tex.push_back(make_float4(0, 0, 0, 0));
       p.brdf_state.push_back(make_int4(0, 0, 0, 0));
       p.brdf_share.push_back(0.0f);
       p.seg_o.push_back(make_float4(0, 0, 0, -1));

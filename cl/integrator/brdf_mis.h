@@ -92,9 +92,8 @@ INLINE BrdfPoint brdf_point(const LightSamplerCtx* ls, const SceneBuffers* sc,
   bp.P = xyz_of(pb->shade_P[path]);
   bp.N = xyz_of(pb->shade_N[path]);
   bp.Nq = light_query_normal(pb, path);
-  float4 ns_m = pb->shade_Ns[path];
-  bp.m = sc->materials[(int)float_as_uint_(ns_m.w)];
-  bp.fr = frame_from(xyz_of(ns_m));
+  bp.m = shading_point_material(sc, pb, path);
+  bp.fr = frame_from(xyz_of(pb->shade_Ns[path]));
   bp.wo = xyz_of(pb->shade_wo[path]);
   bp.wo_local = frame_to_local(&bp.fr, bp.wo);
   bp.lobe = cap_lobe_make(&bp.m, &bp.fr, bp.wo);

@@ -29,9 +29,8 @@ INLINE int light_point_from(const SceneBuffers* sc, const PathBuffers* pb, int p
   float3 N = xyz_of(pb->shade_N[path]);
   // Light arriving from below the geometric surface would leak through it (shading normals).
   if (!(s.pdf > 0.0f) || !(dot(N, s.wi) > 0.0f) || !(max3(s.Li) > 0.0f)) return 0;
-  float4 ns_m = pb->shade_Ns[path];
-  Material m = sc->materials[(int)float_as_uint_(ns_m.w)];
-  float3 Ns = xyz_of(ns_m);
+  Material m = shading_point_material(sc, pb, path);
+  float3 Ns = xyz_of(pb->shade_Ns[path]);
   float cos_s = dot(Ns, s.wi); // = the local frame's wi.z
   if (!(cos_s > 0.0f)) return 0;
   if (!HAS_MICROFACET || m.type == MATERIAL_DIFFUSE) {

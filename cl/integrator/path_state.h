@@ -4,6 +4,7 @@
 #ifndef CANOPY_INTEGRATOR_PATH_STATE_H
 #define CANOPY_INTEGRATOR_PATH_STATE_H
 
+#include "../kernel_features.h"
 #include "../types.h"
 
 // The path state, one line per buffer: X(element type, name). The name is the PathBuffers field,
@@ -31,6 +32,9 @@
   X(float4, shade_wo)                                                                              \
   /* xyz: shading normal (on wo's side; the geometric normal when flat), w: material (int bits) */ \
   X(float4, shade_Ns)                                                                              \
+  /* With image textures: the textured material's albedo (xyz) and alpha (w) at the shading */     \
+  /* point (shading_point_material), written only where its material has a texture */              \
+  X(float4, shade_tex)                                                                             \
   /* brdf-mis, brdf-oriented (brdf_mis.h): x: cut size, y: BRDF-aware samples N (-1: a glossy */   \
   /* point whose cut is not built yet), z: samples drawn, w: n_hit | n_nohit << 16 (Alg. 1) */     \
   X(int4, brdf_state)                                                                              \
@@ -60,7 +64,12 @@
   /* three unit vertex normals per smooth triangle (Primitive.normals, cl/geometry.h) */            \
   X(float4, shading_normals)                                                                       \
   /* the scene's participating medium (one record; zeros without one) */                          \
-  X(Medium, medium)
+  X(Medium, medium)                                                                                \
+  /* Image textures (cl/texture.h): with a textured material, three uv per scene triangle (at */    \
+  /* v0, v1, v2; primitive t < the triangle count is triangle t), the textures and their texels */ \
+  X(float2, texcoords)                                                                             \
+  X(Texture, textures)                                                                             \
+  X(float, texels)
 // clang-format on
 
 #define CANOPY_PATH_FIELD(T, name) GLOBAL T* name;
@@ -83,6 +92,18 @@ typedef struct SceneBuffers {
 // shade_surface, light_pick and the BRDF-oriented cut all read it here, so their pmfs agree.
 INLINE float3 light_query_normal(const PathBuffers* pb, int path) {
   return xyz_of(pb->shade_Ns[path]);
+}
+
+// The material at the path's shading point: the scene's material, with the textured albedo and
+// alpha that shade_surface looked up at the hit (cl/texture.h) where it has textures.
+INLINE Material shading_point_material(const SceneBuffers* sc, const PathBuffers* pb, int path) {
+  Material m = sc->materials[(int)float_as_uint_(pb->shade_Ns[path].w)];
+  if (HAS_TEXTURES ? (m.albedo_texture | m.alpha_texture) != 0 : 0) {
+    float4 t = pb->shade_tex[path];
+    m.albedo = f4_from3(xyz_of(t), 0.0f);
+    m.alpha = t.w;
+  }
+  return m;
 }
 
 // Whether the camera ray of a path (depth 0) hits an emitter: the pixels whose error is measured

@@ -22,6 +22,7 @@
 #include "../lights/light_sample.h"
 #include "../rng.h"
 #include "../shading.h"
+#include "../texture.h"
 #include "brdf_mis.h"
 #include "light_sampler.h"
 #include "path_state.h"
@@ -107,6 +108,12 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   PathRng r;
   r.state = pb->rng[path];
   Material m = sc->materials[prim->material];
+  if (HAS_TEXTURES ? (m.albedo_texture | m.alpha_texture) != 0 : 0) {
+    // The textured albedo and alpha at the hit, kept for light_pick and brdf_mis
+    // (shading_point_material).
+    material_apply_textures(&m, sc->texcoords, sc->textures, sc->texels, h.prim, h.u, h.v);
+    pb->shade_tex[path] = f4_from3(xyz_of(m.albedo), m.alpha);
+  }
   uint light_seed = rng_next_u32(&r);
   float u1 = rng_next_float(&r);
   float u2 = rng_next_float(&r);

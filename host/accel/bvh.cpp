@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -311,6 +312,17 @@ SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& material
   g.shading_normals.reserve(scene.shading_normals.size());
   for (const float3& n : scene.shading_normals)
     g.shading_normals.push_back(f4_from3(n, 0.0f));
+  const bool textured = std::any_of(materials.begin(), materials.end(), [](const Material& m) {
+    return m.albedo_texture > 0 || m.alpha_texture > 0;
+  });
+  if (textured && !scene.triangle_uvs.empty()) {
+    g.texcoords = scene.triangle_uvs;
+  } else if (textured) {
+    g.texcoords.reserve(3 * scene.triangle_count());
+    for (size_t t = 0; t < scene.triangle_count(); ++t)
+      g.texcoords.insert(g.texcoords.end(),
+                         {make_float2(0, 0), make_float2(1, 0), make_float2(1, 1)});
+  }
   g.bvh = build_bvh(g.prims);
   float3 lo = make_float3(0, 0, 0), hi = lo;
   bool any = false;

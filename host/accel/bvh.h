@@ -24,6 +24,9 @@ struct SceneGeometry {
   // triangle's Primitive::normals indexes its first of three (cl/geometry.h
   // primitive_shading_normal). Empty when every triangle is flat.
   std::vector<float4> shading_normals;
+  // With a textured material: three uv per scene triangle (Scene::triangle_uvs, or the default
+  // (0, 0), (1, 0), (1, 1) when no mesh has uv); empty otherwise (cl/texture.h).
+  std::vector<float2> texcoords;
   Bvh bvh;
   float3 bounds_min{0, 0, 0}, bounds_max{0, 0, 0};
 };

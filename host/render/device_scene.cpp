@@ -43,7 +43,7 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
                                 int emission_exponent, const Medium& medium,
                                 const std::vector<Light>& infinite_lights,
-                                const EnvironmentData& environment) {
+                                const EnvironmentData& environment, const TextureData& textures) {
   DeviceScene d;
   d.nodes = upload_buffer(ctx, geometry.bvh.nodes);
   d.leaf_blocks = upload_buffer(ctx, geometry.bvh.leaf_blocks);
@@ -51,6 +51,9 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
   d.materials = upload_buffer(ctx, materials);
   d.shading_normals = upload_buffer(ctx, geometry.shading_normals); // one element when empty
   d.medium = upload_buffer(ctx, std::vector<Medium>{medium});
+  d.texcoords = upload_buffer(ctx, geometry.texcoords); // one element each without textures
+  d.textures = upload_buffer(ctx, textures.textures);
+  d.texels = upload_buffer(ctx, textures.texels);
   upload_light_sampler(ctx, lights, sampler, emission_exponent, d, infinite_lights, environment);
   return d;
 }

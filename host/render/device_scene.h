@@ -8,6 +8,7 @@
 #include "integrator/path_state.h"
 #include "render/environment_map.h"
 #include "render/light_sampler_data.h"
+#include "render/texture_data.h"
 
 #include <CL/opencl.hpp>
 
@@ -54,7 +55,8 @@ DeviceScene upload_device_scene(const cl::Context& ctx, const SceneGeometry& geo
                                 const std::vector<Light>& lights, const LightSamplerData& sampler,
                                 int emission_exponent = 0, const Medium& medium = {},
                                 const std::vector<Light>& infinite_lights = {},
-                                const EnvironmentData& environment = {});
+                                const EnvironmentData& environment = {},
+                                const TextureData& textures = {});
 
 // Uploads only the lights and the light sampler's buffers into `d` (the part of
 // upload_device_scene that the pick tests and benchmarks need without any geometry).

@@ -1,10 +1,9 @@
 #include "render/environment_map.h"
 
-#include "image/image_io.h"
 #include "light_tree/light_sampler.h"
 #include "lights/environment.h"
+#include "render/texture_data.h"
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <cmath>
@@ -14,43 +13,6 @@ namespace canopy {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// The map as linear rgb radiance, row 0 = the image's top row.
-std::vector<float4> read_map(const std::filesystem::path& file, int* width, int* height) {
-  const std::string name = file.string();
-  auto in = OIIO::ImageInput::open(name);
-  if (!in) throw SceneError(fmt::format("{}: cannot read the environment map", name));
-  const OIIO::ImageSpec spec = in->spec();
-  const int nc = spec.nchannels;
-  if (spec.width < 1 || spec.height < 1 || nc < 1)
-    throw SceneError(fmt::format("{}: an environment map needs pixels", name));
-  if (uint64_t(spec.width) * uint64_t(spec.height) > kMaxEnvironmentTexels)
-    throw SceneError(fmt::format("{}: {}x{} texels is more than an environment map may have ({})",
-                                 name, spec.width, spec.height, kMaxEnvironmentTexels));
-  std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(nc));
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
-    throw SceneError(
-        fmt::format("{}: cannot read the environment map (truncated or corrupt)", name));
-  // Integer images (PNG, JPEG, TGA, ...) hold sRGB-encoded values; float ones (EXR, HDR) linear.
-  const bool srgb = spec.format.basetype != OIIO::TypeDesc::FLOAT &&
-                    spec.format.basetype != OIIO::TypeDesc::HALF &&
-                    spec.format.basetype != OIIO::TypeDesc::DOUBLE;
-  std::vector<float4> texels(size_t(spec.width) * size_t(spec.height));
-  for (size_t p = 0; p < texels.size(); ++p) {
-    float c[3];
-    for (int k = 0; k < 3; ++k) {
-      float v = all[p * size_t(nc) + size_t(nc >= 3 ? k : 0)]; // grey: one channel for all three
-      if (!std::isfinite(v) || v < 0.0f)
-        throw SceneError(fmt::format("{}: texel ({}, {}) is {} (radiance must be finite and >= 0)",
-                                     name, p % size_t(spec.width), p / size_t(spec.width), v));
-      c[k] = srgb ? srgb_decode(v) : v;
-    }
-    texels[p] = make_float4(c[0], c[1], c[2], 0.0f);
-  }
-  *width = spec.width;
-  *height = spec.height;
-  return texels;
-}
 
 } // namespace
 
@@ -83,8 +45,12 @@ EnvironmentData build_environment_data(std::vector<Light>& infinite,
       continue;
     }
     const EnvironmentMap& map = maps.at(size_t(l.pad));
-    int w = 0, h = 0;
-    std::vector<float4> texels = read_map(map.file, &w, &h);
+    RenderImage img = read_render_image(map.file, "environment map", kMaxEnvironmentTexels, 3);
+    const int w = img.width, h = img.height;
+    std::vector<float4> texels(size_t(w) * size_t(h));
+    for (size_t p = 0; p < texels.size(); ++p)
+      texels[p] =
+          make_float4(img.values[3 * p], img.values[3 * p + 1], img.values[3 * p + 2], 0.0f);
     if (map.projection == ENV_OCTAHEDRAL && w != h)
       throw SceneError(fmt::format("{}: the equal-area octahedral projection needs a square map, "
                                    "not {}x{}",

@@ -14,6 +14,7 @@ struct KernelFeatures {
   bool prim_sphere = false, prim_disk = false;
   bool material_conductor = false, material_plastic = false;
   bool medium = false;          // a participating medium (cl/volume/, shade_volume)
+  bool textures = false;        // a material with an image texture (cl/texture.h)
   bool volume_midpoint = false; // medium segments ranked at their midpoint (ablation)
   int light_sampler = 0;        // SAMPLER_* (cl/types.h)
   bool mis = true;              // RendererOptions::mis

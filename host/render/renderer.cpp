@@ -162,8 +162,11 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
       : scene.lights.empty()
           ? emission_scale_exponent(brightest)
           : std::max(emission_scale_exponent(scene.lights), emission_scale_exponent(brightest));
-  device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
-                                stats_.emission_exponent, scene.medium, infinite, environment);
+  // Texture images likewise.
+  TextureData textures = build_texture_data(scene.textures);
+  device_ =
+      upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
+                          stats_.emission_exponent, scene.medium, infinite, environment, textures);
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
   camera_ = upload_buffer(ctx, cam);

@@ -104,6 +104,13 @@ struct Transform {
   static Transform rotate(double3 unit_axis, double degrees);
 };
 
+// Adds an image texture to the scene: the value for Material::albedo_texture or alpha_texture
+// (1 + its index in Scene::textures).
+inline int add_texture(Scene& s, TextureDesc t) {
+  s.textures.push_back(std::move(t));
+  return int(s.textures.size());
+}
+
 // A triangle mesh in local space, before it is placed into the scene.
 struct Mesh {
   std::vector<float3> vertices;
@@ -116,6 +123,10 @@ struct Mesh {
   // normals, else 3 per triangle.
   std::vector<float3> normals;
   std::vector<int32_t> normal_indices;
+  // Texture coordinates (OBJ vt, PLY u v, pbrt "uv") and, for each triangle, the indices of its
+  // three vertices' uv (-1: none). uv_indices is empty for a mesh without uv, else 3 per triangle.
+  std::vector<float2> uvs;
+  std::vector<int32_t> uv_indices;
 
   size_t triangle_count() const { return indices.size() / 3; }
   void add_triangle(uint32_t a, uint32_t b, uint32_t c, int32_t mat, float3 em) {

@@ -162,6 +162,26 @@ struct EnvironmentMap {
   int projection = 0;
 };
 
+// How an image's stored values become linear ones (pbrt-v4's "encoding" of image textures).
+// Auto: integer formats (PNG, JPEG, TGA, ...) are sRGB-decoded, float formats (EXR, HDR) taken
+// as they are.
+enum class ImageEncoding { Auto, Linear, Srgb, Gamma };
+
+// An image texture of a material (cl/types.h Texture, cl/texture.h): the image file, read by the
+// renderer (host/render/texture_data.h), and how its values are looked up and used. A material
+// refers to it by Material::albedo_texture or alpha_texture (1 + its index in Scene::textures).
+struct TextureDesc {
+  std::filesystem::path file;
+  std::string where; // names it in messages: "<scene file>: texture '<name>'" or "<file>:<line>"
+  int channels = 3;  // 3: rgb (albedo); 1: the mean of the image's colour channels (roughness)
+  ImageEncoding encoding = ImageEncoding::Auto;
+  float gamma = 1.0f;       // ImageEncoding::Gamma: linear = stored^gamma
+  float3 scale{1, 1, 1};    // multiplies the filtered value (a float texture uses x)
+  float4 uvmap{1, 1, 0, 0}; // (s, t) = (x u + z, y v + w)
+  int wrap = TEXTURE_WRAP_REPEAT;
+  int map = TEXTURE_MAP_VALUE; // TEXTURE_MAP_*: how a float texture's value becomes GGX alpha
+};
+
 // All geometry flattened into one world-space triangle soup. Emissive mesh triangles (OBJ/MTL Ke
 // or an emission given in the scene) have a TRIANGLE light with LIGHT_FLAG_FROM_MESH and
 // triangle_light[i] pointing at it. Analytic area lights (sphere, quad, triangle) are NOT in this
@@ -186,7 +206,12 @@ struct Scene {
   // first one, or -1 for a flat triangle. triangle_normals is empty while every triangle is flat.
   std::vector<float3> shading_normals;
   std::vector<int32_t> triangle_normals;
-  std::vector<Light> lights; // only lights that emit (zero-emission lights are skipped)
+  // Texture coordinates: the uv at the three vertices of every triangle (in its vertex order),
+  // once any mesh has them; empty while none has. A triangle given without uv has pbrt-v4's
+  // default (0, 0), (1, 0), (1, 1).
+  std::vector<float2> triangle_uvs;
+  std::vector<TextureDesc> textures; // image textures of the materials
+  std::vector<Light> lights;         // only lights that emit (zero-emission lights are skipped)
   // Lights at infinity (LIGHT_DISTANT, LIGHT_ENVIRONMENT; at most MAX_INFINITE_LIGHTS): apart from
   // `lights`, which the light samplers and the tree cover; every shading point samples each of
   // them. An environment light with a map has its index in environment_maps in Light::pad (-1:

@@ -133,6 +133,13 @@ size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
     reserve_more(s.shading_normals, 3 * nt);
   }
   if (!s.triangle_normals.empty()) reserve_more(s.triangle_normals, nt);
+  // Texture coordinates: the earlier triangles get the default once a mesh brings uv.
+  const bool has_uv = !mesh.uv_indices.empty();
+  const float2 default_uv[3] = {make_float2(0, 0), make_float2(1, 0), make_float2(1, 1)};
+  if (has_uv && s.triangle_uvs.empty())
+    for (size_t t = 0; t < first_tri; ++t)
+      s.triangle_uvs.insert(s.triangle_uvs.end(), default_uv, default_uv + 3);
+  if (!s.triangle_uvs.empty()) reserve_more(s.triangle_uvs, 3 * nt);
   for (size_t t = 0; t < nt; ++t) {
     uint32_t a = base + mesh.indices[3 * t], bb = base + mesh.indices[3 * t + 1],
              c = base + mesh.indices[3 * t + 2];
@@ -160,6 +167,21 @@ size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
       s.triangle_normals.push_back(first);
     } else if (!s.triangle_normals.empty()) {
       s.triangle_normals.push_back(-1);
+    }
+    if (!s.triangle_uvs.empty()) {
+      float2 uv[3] = {default_uv[0], default_uv[1], default_uv[2]};
+      if (has_uv) {
+        // A triangle lacking uv at a vertex takes the default at all three.
+        bool ok = true;
+        for (int k = 0; k < 3; ++k) {
+          int32_t ui = mesh.uv_indices[3 * t + size_t(k)];
+          ok = ok && ui >= 0;
+          if (ok) uv[k] = mesh.uvs[size_t(ui)];
+        }
+        if (!ok) std::copy(default_uv, default_uv + 3, uv);
+      }
+      if (flip) std::swap(uv[1], uv[2]);
+      s.triangle_uvs.insert(s.triangle_uvs.end(), uv, uv + 3);
     }
     int32_t light = -1;
     float3 em = mesh.emission[t];
