@@ -36,7 +36,8 @@ using namespace canopy;
 namespace {
 
 // A box room with every material (diffuse; rough and mirror conductors; rough and smooth-coat
-// plastics; a smooth-shaded OBJ) lit by every light type: point, spot, sphere, quad, triangle, disk
+// plastics; a smooth-shaded OBJ; image textures for a diffuse albedo and a plastic's albedo and
+// roughness) lit by every light type: point, spot, sphere, quad, triangle, disk
 // (one-sided on the ceiling, two-sided in view of the camera), an emissive quad shape (mesh-light
 // triangles) and 300 random points, so the light tree has several levels.
 const char* kSceneJson = R"({
@@ -47,7 +48,10 @@ const char* kSceneJson = R"({
                  { "name": "gold", "type": "conductor", "metal": "gold", "roughness": 0.3 },
                  { "name": "mirror", "type": "conductor", "metal": "silver", "roughness": 0 },
                  { "name": "glossy", "type": "plastic", "albedo": [0.2, 0.3, 0.6], "roughness": 0.1 },
-                 { "name": "coat", "type": "plastic", "albedo": [0.5, 0.5, 0.2], "roughness": 0 } ],
+                 { "name": "coat", "type": "plastic", "albedo": [0.5, 0.5, 0.2], "roughness": 0 },
+                 { "name": "painted", "albedo": { "texture": "textures/colours.png", "uv_scale": [3, 2] } },
+                 { "name": "worn", "type": "plastic", "albedo": { "texture": "textures/colours.png" },
+                   "roughness": { "texture": "textures/roughness.png", "wrap": "clamp" } } ],
   "shapes": [
     { "type": "box", "material": "white", "min": [-3, 0, -3], "max": [3, 3, 3] },
     { "type": "box", "material": "red", "min": [-0.5, 0, -0.5], "max": [0.5, 1, 0.5], "rotate_y": 30 },
@@ -55,6 +59,8 @@ const char* kSceneJson = R"({
     { "type": "box", "material": "mirror", "min": [-2.9, 0, -2.9], "max": [-1.0, 2.5, -2.8] },
     { "type": "box", "material": "glossy", "min": [-2.0, 0, 1.0], "max": [-1.0, 0.8, 2.0] },
     { "type": "box", "material": "coat", "min": [1.0, 0, 1.5], "max": [2.5, 0.4, 2.5] },
+    { "type": "box", "material": "painted", "min": [-2.9, 0, -0.5], "max": [-2.5, 2.0, 0.5] },
+    { "type": "box", "material": "worn", "min": [2.5, 0, -0.5], "max": [2.9, 2.0, 1.0] },
     { "type": "obj", "file": "smooth.obj", "material": "gold",
       "transform": { "scale": 1.5, "translate": [0.5, 1.2, 0.5] } },
     { "type": "quad", "corner": [-1, 2.9, -1], "edge1": [2, 0, 0], "edge2": [0, 0, 0.2],
@@ -113,6 +119,7 @@ protected:
     for (const MaterialDesc& m : scene_.materials)
       materials_.push_back(m.gpu);
     geometry_ = build_scene_geometry(scene_, materials_);
+    textures_ = build_texture_data(scene_.textures);
     // The loader stores coordinates relative to the camera position (Scene::origin); the points
     // below are chosen in world space and shifted the same way.
     origin_ = make_float3(float(scene_.origin.x), float(scene_.origin.y), float(scene_.origin.z));
@@ -206,12 +213,13 @@ protected:
                          Paths& ref, const std::vector<int>& queue);
   void upload_scene() {
     dev_ = upload_device_scene(rt_.context(), geometry_, materials_, scene_.lights, sampler_, 0,
-                               scene_.medium);
+                               scene_.medium, {}, {}, textures_);
   }
   SceneBuffers host_scene() {
-    return SceneBuffers{geometry_.bvh.nodes.data(),       geometry_.bvh.leaf_blocks.data(),
-                        geometry_.prims.data(),           materials_.data(),
-                        geometry_.shading_normals.data(), &scene_.medium};
+    return SceneBuffers{
+        geometry_.bvh.nodes.data(), geometry_.bvh.leaf_blocks.data(), geometry_.prims.data(),
+        materials_.data(),          geometry_.shading_normals.data(), &scene_.medium,
+        geometry_.texcoords.data(), textures_.textures.data(),        textures_.texels.data()};
   }
 
   ClRuntime rt_;
@@ -219,6 +227,7 @@ protected:
   float3 origin_{0, 0, 0}; // scene_.origin in float
   std::vector<Material> materials_;
   SceneGeometry geometry_;
+  TextureData textures_; // the two textured materials' images
   LightSamplerData sampler_;
   std::vector<float2> host_cut_; // the host's brdf_cut storage (brdf-mis, brdf-oriented)
   cl::Program program_;
@@ -242,6 +251,7 @@ void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& w
     expect_close(dev.shade_Ns[p].x, ref.shade_Ns[p].x, at + " Ns");
     EXPECT_EQ(float_as_uint_(dev.shade_Ns[p].w), float_as_uint_(ref.shade_Ns[p].w))
         << at << " material";
+    expect_close4(dev.shade_tex[p], ref.shade_tex[p], at + " shade_tex");
     if (::testing::Test::HasFailure()) return; // one path's report is enough
   }
 }
@@ -260,6 +270,12 @@ TEST_P(KernelStages, ShadeSurfaceAndLightPickMatchTheHost) {
   for (const Hit& h : paths.hits)
     hits += h.prim >= 0;
   ASSERT_GT(hits, kPaths * 9 / 10);
+  int textured = 0; // camera-depth hits on a textured material (shade_tex is compared there)
+  for (const Hit& h : paths.hits) {
+    const Material& m = materials_[size_t(geometry_.prims[size_t(std::max(h.prim, 0))].material)];
+    textured += h.prim >= 0 && (m.albedo_texture > 0 || m.alpha_texture > 0);
+  }
+  ASSERT_GT(textured, kPaths / 50);
 
   int segments_seen = 0, scattered_seen = 0;
   // max_depth is 3: depth 3 is the rays after the last vertex, which only add emission.

@@ -331,8 +331,86 @@ Medium parse_medium(const JsonValue& v, double3 origin) {
   return m;
 }
 
+// An image texture given for a material's "albedo" (channels 3) or "roughness" (channels 1):
+// {"texture": file, "scale", "wrap", "encoding", "uv_scale", "uv_offset"} (docs/scene-format.md,
+// Textures).
+TextureDesc parse_texture(const JsonValue& v, const Builder& b, int channels) {
+  auto o = v.as_object();
+  o.allow({"texture", "scale", "wrap", "encoding", "uv_scale", "uv_offset"});
+  TextureDesc t;
+  auto fv = o.req("texture");
+  std::string f = fv.as_string();
+  if (f.empty()) fv.fail("must not be empty");
+  std::filesystem::path p(f);
+  if (p.is_relative()) p = b.base_dir / p;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(p, ec))
+    fv.fail(fmt::format("{}: no such file", p.string()));
+  t.file = p;
+  t.where = fmt::format("{}: {}", b.file, v.path());
+  t.channels = channels;
+  if (auto sv = o.get("scale")) {
+    if (channels == 1) {
+      float k = sv->as_float_nonneg();
+      t.scale = make_float3(k, k, k);
+    } else {
+      t.scale = sv->as_color();
+    }
+  }
+  if (auto wv = o.get("wrap")) {
+    std::string w = wv->as_enum({"repeat", "clamp", "black"});
+    t.wrap = w == "repeat" ? TEXTURE_WRAP_REPEAT
+                           : (w == "clamp" ? TEXTURE_WRAP_CLAMP : TEXTURE_WRAP_BLACK);
+  }
+  if (auto ev = o.get("encoding")) {
+    if (ev->is_number()) {
+      t.encoding = ImageEncoding::Gamma;
+      t.gamma = ev->as_float_in(0.01f, 100.0f);
+    } else {
+      std::string e = ev->as_enum({"auto", "srgb", "linear"});
+      t.encoding = e == "auto" ? ImageEncoding::Auto
+                               : (e == "srgb" ? ImageEncoding::Srgb : ImageEncoding::Linear);
+    }
+  }
+  auto pair = [](const JsonValue& a) {
+    if (!a.is_array() || a.array_size() != 2) a.fail("must be an array of 2 numbers");
+    return make_float2(a.at(0).as_float(), a.at(1).as_float());
+  };
+  if (auto sv = o.get("uv_scale")) {
+    float2 k = pair(*sv);
+    t.uvmap.x = k.x;
+    t.uvmap.y = k.y;
+  }
+  if (auto ov = o.get("uv_offset")) {
+    float2 d = pair(*ov);
+    t.uvmap.z = d.x;
+    t.uvmap.w = d.y;
+  }
+  return t;
+}
+
+// A material's "albedo": a reflectance (rgb in [0, 1]) or an image texture.
+void parse_albedo(const JsonValue& v, Builder& b, MaterialDesc& d) {
+  if (v.is_object()) {
+    d.gpu.albedo = make_float4(0, 0, 0, 0);
+    d.gpu.albedo_texture = add_texture(b.scene, parse_texture(v, b, 3));
+  } else {
+    d.gpu.albedo = f4_from3(v.as_albedo(), 0.0f);
+  }
+}
+
+// A material's "roughness": r in [0, 1] (GGX alpha = r^2) or a texture of r.
+float parse_roughness(const JsonValue& v, Builder& b, MaterialDesc& d) {
+  if (!v.is_object()) return v.as_float_in(0.0f, 1.0f);
+  TextureDesc t = parse_texture(v, b, 1);
+  t.map = TEXTURE_MAP_ALPHA_SQUARE;
+  d.gpu.alpha_texture = add_texture(b.scene, std::move(t));
+  return 0.5f; // the material's constant, unused where the texture applies
+}
+
 // One entry of "materials" (docs/scene-format.md, Materials). Roughness r becomes GGX alpha = r^2.
-MaterialDesc parse_material(const JsonValue& v) {
+// "albedo" and "roughness" may be image textures.
+MaterialDesc parse_material(const JsonValue& v, Builder& b) {
   auto o = v.as_object();
   auto nv = o.req("name");
   std::string name = nv.as_string();
@@ -341,11 +419,15 @@ MaterialDesc parse_material(const JsonValue& v) {
   if (auto t = o.get("type")) type = t->as_enum({"diffuse", "conductor", "plastic"});
   if (type == "diffuse") {
     o.allow({"name", "type", "albedo"});
-    return diffuse_material(name, o.req("albedo").as_albedo());
+    MaterialDesc d = diffuse_material(name, make_float3(0, 0, 0));
+    parse_albedo(o.req("albedo"), b, d);
+    return d;
   }
   if (type == "conductor") {
     o.allow({"name", "type", "roughness", "metal", "eta", "k"});
-    float r = o.req("roughness").as_float_in(0.0f, 1.0f);
+    MaterialDesc d{};
+    float r = parse_roughness(o.req("roughness"), b, d);
+    const int alpha_texture = d.gpu.alpha_texture;
     auto metal = o.get("metal");
     auto eta = o.get("eta");
     auto k = o.get("k");
@@ -354,30 +436,37 @@ MaterialDesc parse_material(const JsonValue& v) {
       for (const auto& x : {eta, k})
         if (x) x->fail("not allowed together with \"metal\" (give a preset or eta and k)");
       const MetalPreset* p = find_metal_preset(metal->as_enum(metal_preset_names()));
-      return conductor_material(name, r, make_float3(p->eta[0], p->eta[1], p->eta[2]),
-                                make_float3(p->k[0], p->k[1], p->k[2]));
+      d = conductor_material(name, r, make_float3(p->eta[0], p->eta[1], p->eta[2]),
+                             make_float3(p->k[0], p->k[1], p->k[2]));
+    } else {
+      if (!eta && !k) o.fail("a conductor needs \"metal\" (a preset name) or \"eta\" and \"k\"");
+      float3 e = o.req("eta").as_color_in(kMinConductorEta, kMaxConductorIndex);
+      float3 kk = o.req("k").as_color_in(0.0f, kMaxConductorIndex);
+      d = conductor_material(name, r, e, kk);
     }
-    if (!eta && !k) o.fail("a conductor needs \"metal\" (a preset name) or \"eta\" and \"k\"");
-    float3 e = o.req("eta").as_color_in(kMinConductorEta, kMaxConductorIndex);
-    float3 kk = o.req("k").as_color_in(0.0f, kMaxConductorIndex);
-    return conductor_material(name, r, e, kk);
+    d.gpu.alpha_texture = alpha_texture;
+    return d;
   }
   // plastic
   o.allow({"name", "type", "albedo", "specular", "roughness", "ior"});
-  float3 albedo = o.req("albedo").as_albedo();
+  MaterialDesc d{};
+  parse_albedo(o.req("albedo"), b, d);
+  float r = parse_roughness(o.req("roughness"), b, d);
   float3 spec = make_float3(1, 1, 1);
   if (auto sp = o.get("specular")) spec = sp->as_color();
-  float r = o.req("roughness").as_float_in(0.0f, 1.0f);
   float ior = kDefaultPlasticIor;
   if (auto i = o.get("ior")) ior = i->as_float_in(1.0f, kMaxPlasticIor);
-  return plastic_material(name, albedo, spec, r, ior);
+  MaterialDesc p = plastic_material(name, xyz_of(d.gpu.albedo), spec, r, ior);
+  p.gpu.albedo_texture = d.gpu.albedo_texture;
+  p.gpu.alpha_texture = d.gpu.alpha_texture;
+  return p;
 }
 
 void parse_materials(const JsonValue& v, Builder& b) {
   Scene& s = b.scene;
   bool default_replaced = false;
   for (const JsonValue& mv : v.as_array()) {
-    MaterialDesc d = parse_material(mv);
+    MaterialDesc d = parse_material(mv, b);
     const std::string& name = d.name;
     auto nv = mv.as_object().req("name");
     if (name == "default" && !default_replaced) {

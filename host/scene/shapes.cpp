@@ -42,12 +42,17 @@ Transform parse_transform(const JsonValue& v) {
 
 namespace {
 
-// Appends a parallelogram (two triangles) with normal along cross(e1, e2).
+// Appends a parallelogram (two triangles) with normal along cross(e1, e2), and uv (0, 0) at c,
+// (1, 0) at c + e1, (0, 1) at c + e2.
 void add_quad(Mesh& m, float3 c, float3 e1, float3 e2, int mat, float3 em) {
   uint32_t base = uint32_t(m.vertices.size());
   m.vertices.insert(m.vertices.end(), {c, c + e1, c + e1 + e2, c + e2});
+  m.uvs.insert(m.uvs.end(),
+               {make_float2(0, 0), make_float2(1, 0), make_float2(1, 1), make_float2(0, 1)});
   m.add_triangle(base, base + 1, base + 2, mat, em);
   m.add_triangle(base, base + 2, base + 3, mat, em);
+  for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u})
+    m.uv_indices.push_back(int32_t(base + i));
 }
 
 } // namespace
