@@ -226,6 +226,107 @@ TEST(SceneLoader, Plastic) {
   EXPECT_EQ(s.materials[0].gpu.ior, 1.0f);
 }
 
+// Image textures for albedo and roughness (docs/scene-format.md, Textures): each becomes a
+// TextureDesc the material refers to by 1 + its index; the file is resolved against the scene's
+// directory and must exist.
+TEST(SceneLoader, Textures) {
+  Scene s = load_str(scene_with(R"("materials": [
+      {"name": "wood", "albedo": {"texture": "textures/colours.png"}},
+      {"name": "worn", "type": "plastic", "roughness": 0.2,
+       "albedo": {"texture": "textures/colours.png", "scale": [0.5, 1, 2], "wrap": "clamp",
+                  "encoding": "linear", "uv_scale": [2, 3], "uv_offset": [0.25, -1]}},
+      {"name": "brushed", "type": "conductor", "metal": "gold",
+       "roughness": {"texture": "textures/roughness.png", "scale": 0.5, "encoding": 2.2,
+                     "wrap": "black"}},
+      {"name": "plain", "albedo": 0.5}])"));
+  ASSERT_EQ(s.textures.size(), 3u);
+  const Material& wood = s.materials[1].gpu;
+  EXPECT_EQ(wood.albedo_texture, 1);
+  EXPECT_EQ(wood.alpha_texture, 0);
+  const TextureDesc& w = s.textures[0];
+  EXPECT_EQ(w.file, std::filesystem::path(CANOPY_TEST_DATA_DIR) / "textures/colours.png");
+  EXPECT_EQ(w.channels, 3);
+  EXPECT_EQ(w.encoding, ImageEncoding::Auto);
+  EXPECT_EQ(w.wrap, TEXTURE_WRAP_REPEAT);
+  EXPECT_EQ(w.map, TEXTURE_MAP_VALUE);
+  EXPECT_EQ(w.scale.x, 1.0f);
+  EXPECT_EQ(w.uvmap.x, 1.0f);
+  EXPECT_EQ(w.uvmap.z, 0.0f);
+  EXPECT_NE(w.where.find("scene.json"), std::string::npos);
+  const Material& worn = s.materials[2].gpu;
+  EXPECT_EQ(worn.type, MATERIAL_PLASTIC);
+  EXPECT_EQ(worn.albedo_texture, 2);
+  EXPECT_EQ(worn.alpha_texture, 0);
+  EXPECT_FLOAT_EQ(worn.alpha, 0.04f);
+  const TextureDesc& t = s.textures[1];
+  EXPECT_EQ(t.scale.z, 2.0f);
+  EXPECT_EQ(t.wrap, TEXTURE_WRAP_CLAMP);
+  EXPECT_EQ(t.encoding, ImageEncoding::Linear);
+  EXPECT_EQ(t.uvmap.x, 2.0f);
+  EXPECT_EQ(t.uvmap.y, 3.0f);
+  EXPECT_EQ(t.uvmap.z, 0.25f);
+  EXPECT_EQ(t.uvmap.w, -1.0f);
+  const Material& brushed = s.materials[3].gpu;
+  EXPECT_EQ(brushed.type, MATERIAL_CONDUCTOR);
+  EXPECT_EQ(brushed.albedo_texture, 0);
+  EXPECT_EQ(brushed.alpha_texture, 3);
+  const TextureDesc& r = s.textures[2];
+  EXPECT_EQ(r.channels, 1);
+  EXPECT_EQ(r.map, TEXTURE_MAP_ALPHA_SQUARE); // Canopy's roughness: alpha = r^2
+  EXPECT_EQ(r.encoding, ImageEncoding::Gamma);
+  EXPECT_EQ(r.gamma, 2.2f);
+  EXPECT_EQ(r.scale.x, 0.5f);
+  EXPECT_EQ(r.wrap, TEXTURE_WRAP_BLACK);
+  EXPECT_EQ(s.materials[4].gpu.albedo_texture, 0);
+}
+
+// Quads and boxes carry uv (0, 0) at the corner, (1, 0) along edge1 and (0, 1) along edge2; an
+// OBJ without vt then gets pbrt's default per triangle.
+TEST(SceneLoader, QuadUv) {
+  Scene s = load_str(scene_with(R"("shapes": [
+      {"type": "obj", "file": "triangle.obj"},
+      {"type": "quad", "corner": [0, 0, 0], "edge1": [0, 0, 1], "edge2": [1, 0, 0]}])"));
+  ASSERT_EQ(s.triangle_count(), 3u);
+  ASSERT_EQ(s.triangle_uvs.size(), 9u);
+  const float expect[9][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 0},
+                              {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+  for (size_t i = 0; i < 9; ++i) {
+    EXPECT_EQ(s.triangle_uvs[i].x, expect[i][0]) << i;
+    EXPECT_EQ(s.triangle_uvs[i].y, expect[i][1]) << i;
+  }
+}
+
+TEST(SceneLoader, TextureErrors) {
+  auto mat = [](const std::string& m) {
+    return error_of(scene_with(R"("materials": [)" + m + "]"));
+  };
+  EXPECT_NE(
+      mat(R"({"name": "a", "albedo": {"texture": "nope.png"}})").find("nope.png: no such file"),
+      std::string::npos);
+  EXPECT_NE(mat(R"({"name": "a", "albedo": {"texture": ""}})").find("must not be empty"),
+            std::string::npos);
+  EXPECT_NE(mat(R"({"name": "a", "albedo": {"texture": "textures/colours.png", "wrap": "mirror"}})")
+                .find("wrap"),
+            std::string::npos);
+  EXPECT_NE(mat(R"({"name": "a", "albedo": {"texture": "textures/colours.png", "scale": -1}})")
+                .find("scale"),
+            std::string::npos);
+  EXPECT_NE(mat(R"({"name": "a", "albedo": {"texture": "textures/colours.png", "uv_scale": 2}})")
+                .find("array of 2 numbers"),
+            std::string::npos);
+  EXPECT_NE(mat(R"({"name": "a", "albedo": {"texture": "textures/colours.png", "filter": "x"}})")
+                .find("unknown key"),
+            std::string::npos);
+  EXPECT_NE(mat(R"({"name": "a", "type": "conductor", "metal": "gold",
+                    "roughness": {"texture": "textures/roughness.png", "scale": [1, 2, 3]}})")
+                .find("scale"),
+            std::string::npos);
+  EXPECT_NE(mat(R"({"name": "a", "albedo": {"texture": "textures/colours.png",
+                    "encoding": "rec709"}})")
+                .find("encoding"),
+            std::string::npos);
+}
+
 TEST(SceneLoader, PointAndSpot) {
   Scene s = load_str(scene_with("", R"([
       {"type": "point", "position": [1, 2, 3], "intensity": [4, 5, 6]},
