@@ -92,7 +92,7 @@ if(MODE STREQUAL "compare")
 elseif(MODE STREQUAL "converge")
   run_canopy(0 converge "${SCENE}" --reference "${DIR}/ref.exr" --reference-spp 64
              --reference-sampler tree-split
-             --samplers power,tree,tree-noorient,tree-split:0.5,tree-split:0.5/nomis
+             --samplers power,tree,tree-noorient,tree-split:0.5,tree-split:0.5/nomis,auto
              --budget 2
              --seeds 2 --out "${DIR}/tiny")
   foreach(f tiny.csv tiny-median.csv tiny-configs.csv tiny-time.png tiny-rays.png ref.exr)
@@ -106,12 +106,14 @@ elseif(MODE STREQUAL "converge")
   foreach(s ",power,power," ",tree,tree," ",tree-noorient,tree," ",tree-split:0.5,tree-split,0.5,")
     expect_contains("${rows}" "${s}")
   endforeach()
-  # The mis column (before max_depth, mode, timing_seconds): /nomis renders with MIS off, every
-  # other configuration with MIS on.
+  # The mis column (before max_depth, mode, timing_seconds, auto_choice, pilot_seconds): /nomis
+  # renders with MIS off, every other configuration with MIS on; auto names the candidate its
+  # pilot chose.
   file(STRINGS "${DIR}/tiny-configs.csv" cfg_rows)
-  foreach(re "^tiny_converge,tree-split:0.5/nomis,tree-split,0.5,.*,0,1,curve,[0-9.]+$"
-             "^tiny_converge,tree-split:0.5,tree-split,0.5,.*,1,1,curve,[0-9.]+$"
-             "^tiny_converge,power,power,.*,1,1,curve,[0-9.]+$")
+  foreach(re "^tiny_converge,tree-split:0.5/nomis,tree-split,0.5,.*,0,1,curve,[0-9.]+,,0.000$"
+             "^tiny_converge,tree-split:0.5,tree-split,0.5,.*,1,1,curve,[0-9.]+,,0.000$"
+             "^tiny_converge,power,power,.*,1,1,curve,[0-9.]+,,0.000$"
+             "^tiny_converge,auto,auto,.*,1,1,curve,[0-9.]+,(power|tree|brdf-mis/split=0.25),[0-9.]+$")
     set(hits ${cfg_rows})
     list(FILTER hits INCLUDE REGEX "${re}")
     list(LENGTH hits n)

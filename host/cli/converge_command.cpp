@@ -5,6 +5,7 @@
 #include "image/error_stats.h"
 #include "image/image_compare.h"
 #include "image/image_io.h"
+#include "render/auto_sampler.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 
@@ -128,6 +129,10 @@ struct ConfigResult {
   std::vector<MedianPoint> medians; // by spp, increasing
   std::vector<PointStats> points;   // by spp, increasing
   double timing_seconds = 0.0;      // --equal-time: the timing renders that chose the spp
+  // "auto": the configuration its pilot chose (render/auto_sampler.h) and the pilot's seconds,
+  // not counted in the render seconds (like the build and the compile).
+  std::string auto_choice;
+  double pilot_seconds = 0.0;
 };
 
 double seconds_since(Clock::time_point t0) {
@@ -203,6 +208,12 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
       throw SceneError(
           fmt::format("{}: '{}': empty suffix after '/'", option, printable(text, 256)));
   }
+  if (spec == kAutoLightSampler) { // chosen per scene by a pilot (render/auto_sampler.h)
+    if (spec != text)
+      throw SceneError(fmt::format("{}: '{}': auto takes no suffix", option, printable(text, 256)));
+    c.sampler = spec;
+    return c;
+  }
   size_t colon = spec.find(':');
   c.sampler = spec.substr(0, colon);
   if (c.sampler.size() > kNoOrientSuffix.size() && c.sampler.ends_with(kNoOrientSuffix)) {
@@ -256,7 +267,8 @@ RendererOptions renderer_options(const SamplerConfig& c) {
   opt.orientation_term = c.orientation;
   opt.mis = c.mis;
   opt.brdf = c.brdf;
-  return opt;
+  // auto: the first candidate; the pilot then switches
+  return c.sampler == kAutoLightSampler ? auto_candidates(opt).front().options : opt;
 }
 
 std::vector<SamplerConfig> parse_configs(const std::string& list, const IntegratorSettings& scene) {
@@ -609,13 +621,14 @@ void write_csvs(const fs::path& prefix, const std::string& scene, double ref_mse
   std::ofstream cfg = open_out(prefix.string() + "-configs.csv");
   cfg << "scene,sampler,light_sampler,split_threshold,build_seconds,light_tree_seconds,"
          "compile_seconds,warmup_seconds,render_seconds,runs,max_spp,mis,max_depth,mode,"
-         "timing_seconds\n";
+         "timing_seconds,auto_choice,pilot_seconds\n";
   for (const ConfigResult& r : results)
-    cfg << fmt::format("{},{},{},{},{:.4f},{:.4f},{:.4f},{:.3f},{:.3f},{},{},{},{},{},{:.3f}\n",
-                       scene, r.config.label, r.config.sampler, r.config.threshold, r.build_seconds,
-                       r.light_tree_seconds, r.compile_seconds, r.warmup_seconds, r.render_seconds,
-                       r.runs.size(), r.medians.empty() ? 0 : r.medians.back().spp,
-                       int(r.config.mis), max_depth, mode, r.timing_seconds);
+    cfg << fmt::format(
+        "{},{},{},{},{:.4f},{:.4f},{:.4f},{:.3f},{:.3f},{},{},{},{},{},{:.3f},{},{:.3f}\n", scene,
+        r.config.label, r.config.sampler, r.config.threshold, r.build_seconds, r.light_tree_seconds,
+        r.compile_seconds, r.warmup_seconds, r.render_seconds, r.runs.size(),
+        r.medians.empty() ? 0 : r.medians.back().spp, int(r.config.mis), max_depth, mode,
+        r.timing_seconds, r.auto_choice, r.pilot_seconds);
   // Per point: means over the seeds with 95% bootstrap intervals, for every pixel and for the
   // pixels without an emitter in view (_ne). efficiency = 1 / (mean MSE x mean seconds).
   std::ofstream pts = open_out(prefix.string() + "-points.csv");
@@ -747,6 +760,13 @@ int run_converge(const ConvergeArgs& a) {
     renderers.push_back(
         std::make_unique<Renderer>(rt, *scenes.back(), renderer_options(res.config)));
     Renderer& renderer = *renderers.back();
+    if (res.config.sampler == kAutoLightSampler) {
+      AutoChoice choice =
+          choose_light_sampler(renderer, renderer_options(res.config), 0xC0FFEEu + 2);
+      res.auto_choice = choice.chosen.label;
+      res.pilot_seconds = choice.pilot_seconds;
+      progress.show(fmt::format("[{}/{}] {}", ci + 1, configs.size(), describe(choice)), true);
+    }
     res.build_seconds = renderer.stats().build_seconds;
     res.light_tree_seconds = renderer.stats().light_tree_seconds;
     res.compile_seconds = renderer.stats().compile_seconds;

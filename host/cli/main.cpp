@@ -14,6 +14,7 @@
 #include "image/error_stats.h"
 #include "image/image_io.h"
 #include "image/partial_image.h"
+#include "render/auto_sampler.h"
 #include "render/memory_budget.h"
 #include "render/renderer.h"
 #include "render/stats_report.h"
@@ -352,7 +353,18 @@ int run_render(const RenderArgs& args) {
   ropt.brdf.n_max = scene.integrator.brdf_n_max;
   ropt.brdf.lambda = scene.integrator.brdf_lambda;
   ropt.brdf.adaptive = scene.integrator.brdf_adaptive;
+  // "auto": the renderer starts with the first candidate; the pilot leaves it at the winner, which
+  // the summary, the metadata and the stats then name.
+  const bool automatic = scene.integrator.light_sampler == kAutoLightSampler;
+  if (automatic) ropt = auto_candidates(ropt).front().options;
   Renderer renderer(rt, scene, ropt);
+  std::optional<AutoChoice> choice;
+  if (automatic) {
+    choice = choose_light_sampler(renderer, ropt, scene.integrator.seed ^ 0x9E3779B9u);
+    scene.integrator.light_sampler = choice->chosen.options.light_sampler;
+    scene.integrator.split_threshold = choice->chosen.options.split_threshold;
+    if (!args.quiet) std::fprintf(stderr, "canopy: %s\n", describe(*choice).c_str());
+  }
   Progress progress(args.quiet);
   RenderSettings settings;
   settings.spp = scene.integrator.spp;
@@ -394,7 +406,8 @@ int run_render(const RenderArgs& args) {
        {"canopy:max_depth", std::to_string(scene.integrator.max_depth)},
        {"canopy:orientation_term", args.no_orientation ? "off" : "on"},
        {"canopy:mis", scene.integrator.mis ? "on" : "off"},
-       {"canopy:spp", std::to_string(scene.integrator.spp)}});
+       {"canopy:spp", std::to_string(scene.integrator.spp)},
+       {"canopy:auto", choice ? describe(*choice) : std::string("off")}});
   write_png(png, img);
   if (!args.heatmap.empty()) write_png(args.heatmap, film.shadow_ray_heatmap());
   if (!args.emitter_mask.empty())
@@ -428,6 +441,17 @@ int run_render(const RenderArgs& args) {
     nlohmann::json j = stats_to_json(st, timings);
     j["scene"] = args.scene;
     j["light_sampler"] = scene.integrator.light_sampler;
+    if (choice) {
+      nlohmann::json a;
+      a["chosen"] = choice->chosen.label;
+      a["pilot_seconds"] = choice->pilot_seconds;
+      for (const PilotResult& c : choice->candidates)
+        a["candidates"].push_back({{"label", c.label},
+                                   {"variance", c.variance},
+                                   {"seconds", c.seconds},
+                                   {"efficiency", c.efficiency}});
+      j["auto"] = a;
+    }
     j["split_threshold"] = scene.integrator.split_threshold;
     j["max_cut"] = scene.integrator.max_cut;
     j["max_depth"] = scene.integrator.max_depth;
@@ -501,7 +525,7 @@ int main(int argc, char** argv) {
   render->add_option("--seed", rargs.seed, "Random seed (overrides the scene)");
   render->add_option("--light-sampler", rargs.light_sampler, "Light sampler (overrides the scene)")
       ->check(CLI::IsMember(
-          std::vector<std::string>(kLightSamplerNames.begin(), kLightSamplerNames.end())));
+          std::vector<std::string>(kLightSamplerChoices.begin(), kLightSamplerChoices.end())));
   render
       ->add_option("--split-threshold", rargs.split_threshold,
                    "tree-split threshold in [0, 1] (overrides the scene; 0 never splits)")

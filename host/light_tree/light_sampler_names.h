@@ -23,6 +23,13 @@ static_assert(kLightSamplerNames[SAMPLER_UNIFORM] == "uniform" &&
               kLightSamplerNames[SAMPLER_BRDF_MIS] == "brdf-mis" &&
               kLightSamplerNames[SAMPLER_BRDF_ORIENTED] == "brdf-oriented");
 
+// The names a scene or the command line may give: every sampler, and "auto", which chooses one of
+// them per scene by a pilot render (host/render/auto_sampler.h).
+inline constexpr std::string_view kAutoLightSampler = "auto";
+inline constexpr std::array<std::string_view, 9> kLightSamplerChoices = {
+    "auto",       "uniform", "power",    "tree",         "tree-split",
+    "exhaustive", "bsdf",    "brdf-mis", "brdf-oriented"};
+
 // The SAMPLER_* kind named `name`, or -1 if no sampler has that name.
 constexpr int light_sampler_kind(std::string_view name) {
   for (size_t k = 0; k < kLightSamplerNames.size(); ++k)

@@ -143,18 +143,18 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   t0 = Clock::now();
   const cl::Context& ctx = rt.context();
   // Environment maps are read here (not by the scene loader): the texels go to the device only.
-  std::vector<Light> infinite = scene.infinite_lights;
-  EnvironmentData environment = build_environment_data(infinite, scene.environment_maps);
+  infinite_ = scene.infinite_lights;
+  environment_ = build_environment_data(infinite_, scene.environment_maps);
   // The exponent of the brightest emission of either list (0 for an empty list: not a candidate);
   // a map's radiance is its scale times its brightest texel.
-  std::vector<Light> brightest = infinite;
+  std::vector<Light> brightest = infinite_;
   for (Light& l : brightest) {
     if (l.type != LIGHT_ENVIRONMENT || l.flags == ENV_CONSTANT) continue;
     float m = 0.0f;
     for (uint32_t k = 0, first = float_as_uint_(l.p.x),
                   n = float_as_uint_(l.p.y) * float_as_uint_(l.p.z);
          k < n; ++k)
-      m = std::max(m, max3(xyz_of(environment.texels[first + k])));
+      m = std::max(m, max3(xyz_of(environment_.texels[first + k])));
     l.emission = l.emission * m;
   }
   stats_.emission_exponent =
@@ -164,28 +164,46 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
           : std::max(emission_scale_exponent(scene.lights), emission_scale_exponent(brightest));
   // Texture images likewise.
   TextureData textures = build_texture_data(scene.textures);
-  device_ =
-      upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
-                          stats_.emission_exponent, scene.medium, infinite, environment, textures);
+  device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
+                                stats_.emission_exponent, scene.medium, infinite_, environment_,
+                                textures);
   std::vector<CameraParams> cam = {
       make_camera_params(scene.camera, scene.film.width, scene.film.height)};
   camera_ = upload_buffer(ctx, cam);
   stats_.upload_seconds = seconds_since(t0);
+  compile_kernels();
+  stats_.cut_size_histogram.assign(kCutBins, 0);
+}
 
-  t0 = Clock::now();
-  KernelFeatures features = options.all_features ? KernelFeatures::all(sampler_.kind)
-                                                 : scene_features(scene, sampler_.kind);
-  features.volume_midpoint = scene.has_medium && scene.integrator.volume_importance == "midpoint";
-  features.mis = options.mis;
+void Renderer::compile_kernels() {
+  auto t0 = Clock::now();
+  KernelFeatures features = options_.all_features ? KernelFeatures::all(sampler_.kind)
+                                                  : scene_features(scene_, sampler_.kind);
+  features.volume_midpoint = scene_.has_medium && scene_.integrator.volume_importance == "midpoint";
+  features.mis = options_.mis;
   brdf_stages_ =
       sampler_.brdf_oriented() && (features.material_conductor || features.material_plastic);
   // Kernels with the medium feature run shade_volume (on a scene without a medium, its record is
   // vacuum: every path passes unchanged, so forcing the feature on changes no image).
   volume_stages_ = features.medium;
   stats_.kernel_options = features.build_options();
-  program_ = rt.build_program(kKernelFiles, stats_.kernel_options);
+  program_ = rt_.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
-  stats_.cut_size_histogram.assign(kCutBins, 0);
+}
+
+void Renderer::set_light_sampler(const RendererOptions& options) {
+  auto t0 = Clock::now();
+  // The geometry, textures and the rest stay; only the sampler's data and the kernels change.
+  options_ = options;
+  sampler_ = make_light_sampler_data(scene_.lights, options.light_sampler, options.split_threshold,
+                                     options.max_cut, options.orientation_term, options.brdf);
+  stats_.light_tree_seconds = sampler_.tree_build_seconds;
+  stats_.build_seconds = seconds_since(t0);
+  t0 = Clock::now();
+  upload_light_sampler(rt_.context(), scene_.lights, sampler_, stats_.emission_exponent, device_,
+                       infinite_, environment_);
+  stats_.upload_seconds = seconds_since(t0);
+  compile_kernels();
 }
 
 Film Renderer::render(const RenderSettings& settings) {

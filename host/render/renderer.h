@@ -141,8 +141,16 @@ public:
   Film render(const RenderSettings& settings);
   const RenderStats& stats() const { return stats_; }
   const SceneGeometry& geometry() const { return geometry_; }
+  const RendererOptions& options() const { return options_; }
+  const Scene& scene() const { return scene_; }
+  // Switches to another light sampler (options.light_sampler and its settings; all_features and
+  // split_queue_items as before): rebuilds its data and the kernels, keeps the geometry, textures
+  // and environment maps (render/auto_sampler.h tries several this way).
+  void set_light_sampler(const RendererOptions& options);
 
 private:
+  void compile_kernels(); // for options_ and sampler_: sets program_, brdf_stages_, volume_stages_
+
   ClRuntime& rt_;
   Scene& scene_;
   SceneGeometry geometry_;
@@ -154,6 +162,8 @@ private:
   bool brdf_stages_ = false;   // brdf-mis / brdf-oriented on a scene with a glossy material
   bool volume_stages_ = false; // kernels with a medium: shade_volume and segment light picks
   DeviceScene device_;
+  std::vector<Light> infinite_; // the scene's lights at infinity, as uploaded (maps resolved)
+  EnvironmentData environment_;
   cl::Buffer camera_;
 };
 

@@ -289,7 +289,7 @@ void parse_integrator(const JsonValue& v, IntegratorSettings& in) {
            "brdf_delta", "brdf_n_max", "brdf_lambda", "brdf_adaptive", "volume_importance"});
   if (auto x = o.get("spp")) in.spp = int(x->as_int(1, kMaxSpp));
   if (auto x = o.get("max_depth")) in.max_depth = int(x->as_int(1, kMaxDepth));
-  if (auto x = o.get("light_sampler")) in.light_sampler = x->as_enum(kLightSamplerNames);
+  if (auto x = o.get("light_sampler")) in.light_sampler = x->as_enum(kLightSamplerChoices);
   if (auto x = o.get("split_threshold")) in.split_threshold = x->as_float_in(0.0f, 1.0f);
   if (auto x = o.get("max_cut")) in.max_cut = int(x->as_int(1, kMaxMaxCut));
   if (auto x = o.get("seed")) in.seed = uint32_t(x->as_int(0, 0xffffffffLL));

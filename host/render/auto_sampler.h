@@ -1,0 +1,47 @@
+// The "auto" light sampler: a short pilot render of each candidate estimator on the scene, and
+// the one with the highest estimated efficiency, 1 / (variance per sample x seconds per sample),
+// renders. No single estimator is within 10% of the best on every shipped scene
+// (docs/results.md): plain `tree` wins where a point's important lights are few, splitting where
+// they are many, `power` where the tree's pick costs more than it buys. The pilot measures which
+// case a scene is.
+#pragma once
+
+#include "render/renderer.h"
+
+#include <string>
+#include <vector>
+
+namespace canopy {
+
+struct PilotResult {
+  std::string label; // the candidate, as `canopy converge` names it (e.g. brdf-mis/split=0.25)
+  RendererOptions options;
+  double variance = 0.0;   // per sample: the mean over channels and non-emitter pixels
+  double seconds = 0.0;    // of the pilot render
+  double efficiency = 0.0; // 1 / (variance x seconds per sample pass); 0 if variance is 0
+};
+
+struct AutoChoice {
+  PilotResult chosen;
+  std::vector<PilotResult> candidates;
+  double pilot_seconds = 0.0; // everything the choice took: switches, compiles, pilot renders
+};
+
+// The candidates for `base` (whose light sampler is ignored): power, tree, and brdf-mis with
+// splitting at the renderer's default threshold (it renders as tree-split on a scene without a
+// glossy material); each keeps base's other settings.
+std::vector<PilotResult> auto_candidates(const RendererOptions& base);
+
+// The pilot: each candidate renders pilot_spp samples (>= 2) of four windows (a quarter of the
+// film, one centred in each quadrant) with `seed`; the per-pixel sample variance, averaged over
+// the pixels whose camera rays saw no emitter (their noise is the emitter's edge, the same for
+// every sampler), and the render time give the estimated efficiency. Leaves `renderer` set to
+// the winner. The choice depends on timings, so it can differ between runs on a loaded machine
+// where two candidates are close; every candidate is unbiased, so only the noise can change.
+AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base, uint32_t seed,
+                                int pilot_spp = 2);
+
+// One line for logs: "auto: tree (pilot 0.84 s; efficiency power 12.3, tree 45.6, ...)".
+std::string describe(const AutoChoice& choice);
+
+} // namespace canopy

@@ -1,0 +1,88 @@
+// The "auto" light sampler (render/auto_sampler.h): the pilot renders every candidate, ranks them
+// by 1 / (variance per sample x seconds), and leaves the renderer set to the winner.
+#include "render/auto_sampler.h"
+#include "scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+using namespace canopy;
+
+namespace {
+
+// A floor under a 30 x 30 grid of point lights a little above it: every point's light is the few
+// lights over it, which power sampling (by power alone: uniform here) almost never picks.
+const char* kGridJson = R"({
+  "camera": { "position": [0, 6, 6], "look_at": [0, 0, 0], "fov": 40 },
+  "film": { "width": 64, "height": 48 },
+  "integrator": { "max_depth": 1 },
+  "shapes": [ { "type": "quad", "corner": [-10, 0, 10], "edge1": [20, 0, 0], "edge2": [0, 0, -20] } ],
+  "light_sets": [ { "type": "grid", "origin": [-10, 0.2, -10], "edge1": [20, 0, 0],
+                    "edge2": [0, 0, 20], "nx": 30, "ny": 30,
+                    "light": { "type": "point", "intensity": 1 } } ]
+})";
+
+} // namespace
+
+TEST(AutoSampler, CandidatesArePowerTreeAndTheSplitBrdfMis) {
+  RendererOptions base;
+  base.max_cut = 32;
+  base.split_threshold = 0.9f;
+  std::vector<PilotResult> c = auto_candidates(base);
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_EQ(c[0].options.light_sampler, "power");
+  EXPECT_EQ(c[1].options.light_sampler, "tree");
+  EXPECT_EQ(c[2].options.light_sampler, "brdf-mis");
+  EXPECT_EQ(c[2].options.split_threshold, LT_DEFAULT_SPLIT_THRESHOLD);
+  EXPECT_EQ(c[2].label, "brdf-mis/split=0.25");
+  for (const PilotResult& p : c)
+    EXPECT_EQ(p.options.max_cut, 32); // the rest of base is kept
+}
+
+// Power sampling is hopeless here: the pilot must see it, and the renderer must end on the winner,
+// the candidate with the highest measured efficiency.
+TEST(AutoSampler, ThePilotRanksByEfficiencyAndLeavesTheWinnerSet) {
+  Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
+  ClRuntime rt;
+  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
+  Renderer renderer(rt, scene, base);
+  AutoChoice choice = choose_light_sampler(renderer, base, 7, 4);
+  ASSERT_EQ(choice.candidates.size(), 3u);
+  for (const PilotResult& c : choice.candidates) {
+    EXPECT_GT(c.variance, 0.0) << c.label;
+    EXPECT_GT(c.seconds, 0.0) << c.label;
+    EXPECT_LE(c.efficiency, choice.chosen.efficiency) << c.label;
+  }
+  // per-sample variance: power's is far above the tree's (the same order of time per sample)
+  EXPECT_GT(choice.candidates[0].variance, 10.0 * choice.candidates[1].variance);
+  EXPECT_NE(choice.chosen.label, "power");
+  EXPECT_EQ(renderer.options().light_sampler, choice.chosen.options.light_sampler);
+  EXPECT_EQ(renderer.options().split_threshold, choice.chosen.options.split_threshold);
+  EXPECT_GE(choice.pilot_seconds, choice.candidates[0].seconds);
+  EXPECT_NE(describe(choice).find("auto: " + choice.chosen.label), std::string::npos);
+  // The renderer renders with it afterwards.
+  RenderSettings rs;
+  rs.spp = 2;
+  Film film = renderer.render(rs);
+  EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
+  EXPECT_EQ(film.sum.size(), size_t(64 * 48));
+}
+
+// Without emitters every candidate's image is black (variance 0): the fastest is taken, and
+// nothing divides by zero.
+TEST(AutoSampler, ABlackScenePicksTheFastest) {
+  std::string json = kGridJson;
+  json.replace(json.find("\"intensity\": 1"), 14, "\"intensity\": 0");
+  Scene scene = load_scene_from_string(json, "black.json", ".");
+  ClRuntime rt;
+  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
+  Renderer renderer(rt, scene, base);
+  AutoChoice choice = choose_light_sampler(renderer, base, 7);
+  double fastest = 1e300;
+  for (const PilotResult& c : choice.candidates) {
+    EXPECT_EQ(c.efficiency, 0.0);
+    fastest = std::min(fastest, c.seconds);
+  }
+  EXPECT_EQ(choice.chosen.seconds, fastest);
+}
