@@ -47,7 +47,7 @@ TEST(AutoSampler, ThePilotRanksByEfficiencyAndLeavesTheWinnerSet) {
   ClRuntime rt;
   RendererOptions base = auto_candidates(RendererOptions{}).front().options;
   Renderer renderer(rt, scene, base);
-  AutoChoice choice = choose_light_sampler(renderer, base, 7, 4);
+  AutoChoice choice = choose_light_sampler(renderer, base, 7);
   ASSERT_EQ(choice.candidates.size(), 3u);
   for (const PilotResult& c : choice.candidates) {
     EXPECT_GT(c.variance, 0.0) << c.label;

@@ -167,9 +167,7 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
   device_ = upload_device_scene(ctx, geometry_, materials_, scene.lights, sampler_,
                                 stats_.emission_exponent, scene.medium, infinite_, environment_,
                                 textures);
-  std::vector<CameraParams> cam = {
-      make_camera_params(scene.camera, scene.film.width, scene.film.height)};
-  camera_ = upload_buffer(ctx, cam);
+  set_film_size(scene.film.width, scene.film.height);
   stats_.upload_seconds = seconds_since(t0);
   compile_kernels();
   stats_.cut_size_histogram.assign(kCutBins, 0);
@@ -189,6 +187,16 @@ void Renderer::compile_kernels() {
   stats_.kernel_options = features.build_options();
   program_ = rt_.build_program(kKernelFiles, stats_.kernel_options);
   stats_.compile_seconds = seconds_since(t0);
+}
+
+void Renderer::set_film_size(int width, int height) {
+  if (width < 1 || height < 1)
+    throw std::invalid_argument(
+        fmt::format("film size {}x{}: must be at least 1x1", width, height));
+  film_w_ = width;
+  film_h_ = height;
+  std::vector<CameraParams> cam = {make_camera_params(scene_.camera, width, height)};
+  camera_ = upload_buffer(rt_.context(), cam);
 }
 
 void Renderer::set_light_sampler(const RendererOptions& options) {
@@ -211,7 +219,7 @@ Film Renderer::render(const RenderSettings& settings) {
   const cl::Context& ctx = rt_.context();
   cl::CommandQueue& q = rt_.queue();
   // The window of the film and the sample range rendered (generate.cl).
-  const int film_w = scene_.film.width, film_h = scene_.film.height;
+  const int film_w = film_w_, film_h = film_h_;
   const PixelWindow win =
       settings.window.empty() ? PixelWindow{0, 0, film_w, film_h} : settings.window;
   if (win.x0 < 0 || win.y0 < 0 || win.x1 > film_w || win.y1 > film_h)

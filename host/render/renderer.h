@@ -147,6 +147,10 @@ public:
   // split_queue_items as before): rebuilds its data and the kernels, keeps the geometry, textures
   // and environment maps (render/auto_sampler.h tries several this way).
   void set_light_sampler(const RendererOptions& options);
+  // Renders a film of width x height pixels from now on (the scene's camera, the same field of
+  // view): the auto sampler's pilot runs at a reduced resolution. The scene's film size is the
+  // initial one.
+  void set_film_size(int width, int height);
 
 private:
   void compile_kernels(); // for options_ and sampler_: sets program_, brdf_stages_, volume_stages_
@@ -165,6 +169,7 @@ private:
   std::vector<Light> infinite_; // the scene's lights at infinity, as uploaded (maps resolved)
   EnvironmentData environment_;
   cl::Buffer camera_;
+  int film_w_ = 0, film_h_ = 0;
 };
 
 } // namespace canopy
