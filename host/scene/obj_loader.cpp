@@ -219,6 +219,12 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     m.normals[i] =
         make_float3(attrib.normals[3 * i], attrib.normals[3 * i + 1], attrib.normals[3 * i + 2]);
 
+  // Texture coordinates as given (check_obj_text has refused non-finite numbers).
+  size_t nt = attrib.texcoords.size() / 2;
+  m.uvs.resize(nt);
+  for (size_t i = 0; i < nt; ++i)
+    m.uvs[i] = make_float2(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]);
+
   // Materials of the MTL, resolved once.
   std::vector<int> mat_index(materials.size(), 0);
   std::vector<float3> mat_emission(materials.size(), make_float3(0, 0, 0));
@@ -234,7 +240,7 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     mat_index[i] = material_override < 0 ? b.mtl_material(name, d) : material_override;
   }
 
-  bool any_normals = false;
+  bool any_normals = false, any_uv = false;
   for (const auto& sh : shapes) {
     const auto& mesh = sh.mesh;
     size_t nf = mesh.num_face_vertices.size();
@@ -243,8 +249,8 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
         at.fail(fmt::format("{}: face {} of '{}' is not a triangle after triangulation", name,
                             f + 1, printable(sh.name)));
       uint32_t idx[3];
-      int32_t nidx[3];
-      bool has_normals = true;
+      int32_t nidx[3], tidx[3];
+      bool has_normals = true, has_uv = true;
       for (int k = 0; k < 3; ++k) {
         int vi = mesh.indices[3 * f + k].vertex_index;
         if (vi < 0 || size_t(vi) >= nv)
@@ -257,6 +263,12 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
                               printable(sh.name)));
         nidx[k] = ni;
         has_normals = has_normals && ni >= 0;
+        int ti = mesh.indices[3 * f + k].texcoord_index; // -1: the face gives no uv
+        if (ti >= 0 && size_t(ti) >= nt)
+          at.fail(fmt::format("{}: face {} of '{}' has a texture coordinate index out of range",
+                              name, f + 1, printable(sh.name)));
+        tidx[k] = ti;
+        has_uv = has_uv && ti >= 0;
       }
       // normal_indices starts at the first triangle with normals (earlier ones: -1).
       if (has_normals && !any_normals) m.normal_indices.assign(3 * m.triangle_count(), -1);
@@ -264,6 +276,12 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
       if (any_normals)
         for (int k = 0; k < 3; ++k)
           m.normal_indices.push_back(has_normals ? nidx[k] : -1);
+      // uv_indices likewise; a face without vt at every vertex has none (add_mesh's default).
+      if (has_uv && !any_uv) m.uv_indices.assign(3 * m.triangle_count(), -1);
+      any_uv = any_uv || has_uv;
+      if (any_uv)
+        for (int k = 0; k < 3; ++k)
+          m.uv_indices.push_back(has_uv ? tidx[k] : -1);
       int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
       int mat = material_override >= 0 ? material_override : 0;
       float3 em = make_float3(0, 0, 0);

@@ -651,6 +651,7 @@ void reverse_winding(Mesh& m) {
     std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
     if (!m.normal_indices.empty())
       std::swap(m.normal_indices[3 * t + 1], m.normal_indices[3 * t + 2]);
+    if (!m.uv_indices.empty()) std::swap(m.uv_indices[3 * t + 1], m.uv_indices[3 * t + 2]);
   }
 }
 
@@ -669,29 +670,39 @@ void face_forward_to_normals(Mesh& m) {
     if (dot3(ng, ns) < 0.0) {
       std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
       std::swap(m.normal_indices[3 * t + 1], m.normal_indices[3 * t + 2]);
+      if (!m.uv_indices.empty()) std::swap(m.uv_indices[3 * t + 1], m.uv_indices[3 * t + 2]);
     }
   }
 }
 
-// The triangles of a polygon mesh whose vertices (and vertex normals, if any, one per vertex) are
-// in m: `idx` holds 3 indices a triangle, or with `bilinear` 4 a pbrt-v4 BilinearPatch (p00 p10
-// p01 p11, whose normal cross(p10 - p00, p01 - p00) the triangles (p00 p10 p11) and
-// (p00 p11 p01) keep). Then pbrt-v4's orientation: towards the vertex normals, else the winding
-// (reversed by ReverseOrientation).
+// The triangles of a polygon mesh whose vertices (and vertex normals and uv, if any, one per
+// vertex) are in m: `idx` holds 3 indices a triangle, or with `bilinear` 4 a pbrt-v4
+// BilinearPatch (p00 p10 p01 p11, whose normal cross(p10 - p00, p01 - p00) the triangles
+// (p00 p10 p11) and (p00 p11 p01) keep). A bilinear patch without "uv" has pbrt-v4's default, its
+// own parameterisation: (0, 0), (1, 0), (0, 1), (1, 1) at p00, p10, p01, p11 (a triangle's
+// default, (0, 0), (1, 0), (1, 1), is Builder::add_mesh's). Then pbrt-v4's orientation: towards
+// the vertex normals, else the winding (reversed by ReverseOrientation).
 void add_polygons(Mesh& m, const std::vector<uint32_t>& idx, bool bilinear, int32_t material,
                   float3 emission, bool reverse) {
-  auto add = [&](uint32_t x, uint32_t y, uint32_t z) {
+  const bool patch_uv = bilinear && m.uvs.empty();
+  if (patch_uv)
+    m.uvs = {make_float2(0, 0), make_float2(1, 0), make_float2(0, 1), make_float2(1, 1)};
+  auto add = [&](uint32_t x, uint32_t y, uint32_t z, std::initializer_list<int32_t> corner_uv) {
     m.add_triangle(x, y, z, material, emission);
     if (!m.normals.empty())
       m.normal_indices.insert(m.normal_indices.end(), {int32_t(x), int32_t(y), int32_t(z)});
+    if (patch_uv)
+      m.uv_indices.insert(m.uv_indices.end(), corner_uv);
+    else if (!m.uvs.empty())
+      m.uv_indices.insert(m.uv_indices.end(), {int32_t(x), int32_t(y), int32_t(z)});
   };
   if (!bilinear) {
     for (size_t t = 0; t + 2 < idx.size(); t += 3)
-      add(idx[t], idx[t + 1], idx[t + 2]);
+      add(idx[t], idx[t + 1], idx[t + 2], {});
   } else {
     for (size_t t = 0; t + 3 < idx.size(); t += 4) {
-      add(idx[t], idx[t + 1], idx[t + 3]);
-      add(idx[t], idx[t + 3], idx[t + 2]);
+      add(idx[t], idx[t + 1], idx[t + 3], {0, 1, 3});
+      add(idx[t], idx[t + 3], idx[t + 2], {0, 3, 2});
     }
   }
   if (!m.normals.empty())
@@ -700,6 +711,10 @@ void add_polygons(Mesh& m, const std::vector<uint32_t>& idx, bool bilinear, int3
     reverse_winding(m);
 }
 
+// pbrt-v4's Sphere, tessellated, with its uv (in object space): u = phi / (2 pi), phi = atan2(y, x)
+// in [0, 2 pi), and v = (theta - thetaZMin) / (thetaZMax - thetaZMin), which for the full sphere
+// is 1 - theta / pi, theta = acos(z / r). The seam (u = 1 against u = 0) and the poles (one vertex,
+// a u per triangle: the middle of its segment) have uv of their own, apart from the vertices.
 Mesh sphere_mesh(float radius) {
   Mesh m;
   const int nr = kSphereRings, ns = kSphereSegments;
@@ -721,36 +736,57 @@ Mesh sphere_mesh(float radius) {
   m.normals.push_back(make_float3(0, 0, -1));
   const uint32_t south = uint32_t(m.vertices.size() - 1);
   auto ring = [&](int i, int j) { return uint32_t(1 + (i - 1) * ns + ((j % ns) + ns) % ns); };
-  auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
+  // uv: the rings' grid (ns + 1 columns: column ns is the seam at u = 1), then the poles' ns each.
+  for (int i = 1; i < nr; ++i)
+    for (int j = 0; j <= ns; ++j)
+      m.uvs.push_back(make_float2(float(double(j) / ns), float(1.0 - double(i) / nr)));
+  const int32_t north_uv = int32_t(m.uvs.size()), south_uv = north_uv + ns;
+  for (float v : {1.0f, 0.0f})
+    for (int j = 0; j < ns; ++j)
+      m.uvs.push_back(make_float2(float((j + 0.5) / ns), v));
+  auto grid = [&](int i, int j) { return int32_t((i - 1) * (ns + 1) + j); };
+  auto tri = [&](uint32_t a, uint32_t b, uint32_t c, int32_t ua, int32_t ub, int32_t uc) {
     m.add_triangle(a, b, c, 0, make_float3(0, 0, 0));
     m.normal_indices.insert(m.normal_indices.end(), {int32_t(a), int32_t(b), int32_t(c)});
+    m.uv_indices.insert(m.uv_indices.end(), {ua, ub, uc});
   };
   // Counter-clockwise seen from outside: the winding normal points out, as pbrt's sphere normal.
   for (int j = 0; j < ns; ++j)
-    tri(0, ring(1, j), ring(1, j + 1));
+    tri(0, ring(1, j), ring(1, j + 1), north_uv + j, grid(1, j), grid(1, j + 1));
   for (int i = 1; i < nr - 1; ++i)
     for (int j = 0; j < ns; ++j) {
-      tri(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1));
-      tri(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1));
+      tri(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), grid(i, j), grid(i + 1, j),
+          grid(i + 1, j + 1));
+      tri(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1), grid(i, j), grid(i + 1, j + 1),
+          grid(i, j + 1));
     }
   for (int j = 0; j < ns; ++j)
-    tri(ring(nr - 1, j), south, ring(nr - 1, j + 1));
+    tri(ring(nr - 1, j), south, ring(nr - 1, j + 1), grid(nr - 1, j), south_uv + j,
+        grid(nr - 1, j + 1));
   return m;
 }
 
-// pbrt's disk: radius r at z = height, normal +z (pbrt-v4 Disk).
+// pbrt's disk: radius r at z = height, normal +z (pbrt-v4 Disk), with its uv: u = phi / (2 pi),
+// v = (radius - r) / (radius - innerradius) (innerradius 0 here: 1 at the centre, 0 on the rim).
+// The seam and the centre have uv of their own, as the sphere's.
 Mesh disk_mesh(float radius, float height) {
   Mesh m;
+  const int ns = kDiskSegments;
   const double pi = 3.14159265358979323846;
   m.vertices.push_back(make_float3(0, 0, height));
-  for (int j = 0; j < kDiskSegments; ++j) {
-    double ph = 2.0 * pi * j / kDiskSegments;
+  for (int j = 0; j < ns; ++j) {
+    double ph = 2.0 * pi * j / ns;
     m.vertices.push_back(
         make_float3(float(radius * std::cos(ph)), float(radius * std::sin(ph)), height));
   }
-  for (int j = 0; j < kDiskSegments; ++j)
-    m.add_triangle(0, uint32_t(1 + j), uint32_t(1 + (j + 1) % kDiskSegments), 0,
-                   make_float3(0, 0, 0));
+  for (int j = 0; j <= ns; ++j) // the rim, column ns the seam at u = 1
+    m.uvs.push_back(make_float2(float(double(j) / ns), 0.0f));
+  for (int j = 0; j < ns; ++j) // the centre, per triangle
+    m.uvs.push_back(make_float2(float((j + 0.5) / ns), 1.0f));
+  for (int j = 0; j < ns; ++j) {
+    m.add_triangle(0, uint32_t(1 + j), uint32_t(1 + (j + 1) % ns), 0, make_float3(0, 0, 0));
+    m.uv_indices.insert(m.uv_indices.end(), {ns + 1 + j, j, j + 1});
+  }
   return m;
 }
 
@@ -1269,13 +1305,29 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
     for (size_t i = 0; i < v->size(); i += 3)
       m.normals.push_back(to_float3({(*v)[i], (*v)[i + 1], (*v)[i + 2]}));
   };
+  // Texture coordinates, one pair per vertex ("float uv" is pbrt-v3's spelling).
+  auto uvs = [&](size_t nverts) {
+    const auto* v = p.get_nums("uv", {"point2", "float"});
+    if (!v) return;
+    const Param& q = *p.find("uv");
+    if (v->size() != 2 * nverts)
+      fail(q.loc, fmt::format("{}: \"{} uv\": wrong count of values ({}; want {}, one pair per "
+                              "vertex)",
+                              p.what(), q.type, v->size(), 2 * nverts));
+    for (size_t i = 0; i < v->size(); i += 2) {
+      float2 uv = make_float2(to_float((*v)[i]), to_float((*v)[i + 1]));
+      if (!std::isfinite(uv.x + uv.y))
+        fail(q.loc, fmt::format("{}: \"{} uv\": a value is too large", p.what(), q.type));
+      m.uvs.push_back(uv);
+    }
+  };
 
   if (type == "trianglemesh" || type == "bilinearmesh") {
     const bool tri = type == "trianglemesh";
     m.vertices = points("P", tri ? 3 : 4);
     std::vector<uint32_t> idx = indices(tri ? 3 : 4, m.vertices.size());
     normals(m.vertices.size());
-    p.find("uv"); // texture coordinates: parsed (checked) but unused until textures are read
+    uvs(m.vertices.size());
     add_polygons(m, idx, !tri, gs_.material, emission(), gs_.reverse);
   } else if (type == "plymesh") {
     // pbrt-v4 makes bilinear patches of a PLY file's quads; triangles are the same surface for
@@ -1294,6 +1346,7 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
            fmt::format("{}: no faces of 3 or more vertices, nothing added, ignored", p.what()));
     m.vertices = std::move(ply.positions);
     m.normals = std::move(ply.normals);
+    m.uvs = std::move(ply.uv);
     add_polygons(m, ply.indices, false, gs_.material, emission(), gs_.reverse);
     // Only used to tessellate for displacement, which is ignored below.
     if (Param* q = p.one("edgelength", {"float"}))

