@@ -57,6 +57,10 @@ const std::string kLeadTri =
     "Shape \"trianglemesh\" \"point3 P\" [0 0 -1  1 0 -1  0 1 -1] \"integer indices\" [0 1 2]\n";
 constexpr size_t kLead = 1;
 
+const Material& material_of(const Scene& s, size_t tri) {
+  return s.materials[size_t(s.triangle_material[tri])].gpu;
+}
+
 void expect_uv(const Scene& s, size_t tri, std::vector<float> want) {
   ASSERT_GE(s.triangle_uvs.size(), 3 * tri + 3);
   for (int k = 0; k < 3; ++k) {
@@ -86,6 +90,276 @@ struct TempDir {
 };
 
 } // namespace
+
+// ---------------------------------------------------------------------------- pbrt Texture
+
+TEST(SceneTexturesPbrt, ImagemapFieldsAndTheMaterialsIndex) {
+  Scene s =
+      load(kHead +
+           "Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" "
+           "\"textures/checker.png\"\n  \"string wrap\" \"clamp\" \"float scale\" 0.5 \"string "
+           "encoding\" \"gamma 2.2\"\n  \"float uscale\" 2 \"float vscale\" 3 \"float udelta\" "
+           "0.25 \"float vdelta\" -0.5 \"string filter\" \"bilinear\" \"float maxanisotropy\" "
+           "4\nMaterial \"diffuse\" \"texture reflectance\" \"wood\"\n" +
+           kTri);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  ASSERT_EQ(s.textures.size(), 1u);
+  const TextureDesc& t = s.textures[0];
+  EXPECT_EQ(t.file, kChecker);
+  EXPECT_EQ(t.where, "t.pbrt:5: texture \"wood\"");
+  EXPECT_EQ(t.channels, 3);
+  EXPECT_EQ(t.encoding, ImageEncoding::Gamma);
+  EXPECT_FLOAT_EQ(t.gamma, 2.2f);
+  EXPECT_FLOAT_EQ(t.scale.x, 0.5f);
+  EXPECT_FLOAT_EQ(t.scale.y, 0.5f);
+  EXPECT_FLOAT_EQ(t.scale.z, 0.5f);
+  EXPECT_FLOAT_EQ(t.uvmap.x, 2.0f);
+  EXPECT_FLOAT_EQ(t.uvmap.y, 3.0f);
+  EXPECT_FLOAT_EQ(t.uvmap.z, 0.25f);
+  EXPECT_FLOAT_EQ(t.uvmap.w, -0.5f);
+  EXPECT_EQ(t.wrap, TEXTURE_WRAP_CLAMP);
+  EXPECT_EQ(t.map, TEXTURE_MAP_VALUE);
+  const Material& m = material_of(s, 0);
+  EXPECT_EQ(m.type, MATERIAL_DIFFUSE);
+  EXPECT_EQ(m.albedo_texture, 1);
+  EXPECT_EQ(m.alpha_texture, 0);
+}
+
+TEST(SceneTexturesPbrt, DefaultsWrapModesAndEncodings) {
+  Scene s = load(
+      kHead + kWood +
+      "Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\" "
+      "\"string wrap\" \"black\" \"string encoding\" \"sRGB\"\nTexture \"l\" \"spectrum\" "
+      "\"imagemap\" \"string filename\" \"textures/checker.png\" \"string wrap\" \"repeat\" "
+      "\"string encoding\" \"linear\"\nMaterial \"diffuse\" \"texture reflectance\" \"wood\"\n" +
+      kTri + "Material \"diffuse\" \"texture reflectance\" \"b\"\n" + kTri +
+      "Material \"diffuse\" \"texture reflectance\" \"l\"\n" + kTri);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  ASSERT_EQ(s.textures.size(), 3u);
+  EXPECT_EQ(s.textures[0].wrap, TEXTURE_WRAP_REPEAT);
+  EXPECT_EQ(s.textures[0].encoding,
+            ImageEncoding::Auto); // pbrt-v4: sRGB for 8 bits, else linear
+  EXPECT_FLOAT_EQ(s.textures[0].scale.x, 1.0f);
+  EXPECT_FLOAT_EQ(s.textures[0].uvmap.x, 1.0f);
+  EXPECT_FLOAT_EQ(s.textures[0].uvmap.y, 1.0f);
+  EXPECT_FLOAT_EQ(s.textures[0].uvmap.z, 0.0f);
+  EXPECT_FLOAT_EQ(s.textures[0].uvmap.w, 0.0f);
+  EXPECT_EQ(s.textures[1].wrap, TEXTURE_WRAP_BLACK);
+  EXPECT_EQ(s.textures[1].encoding, ImageEncoding::Srgb);
+  EXPECT_EQ(s.textures[2].wrap, TEXTURE_WRAP_REPEAT);
+  EXPECT_EQ(s.textures[2].encoding, ImageEncoding::Linear);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(material_of(s, size_t(i)).albedo_texture, i + 1);
+}
+
+TEST(SceneTexturesPbrt, EncodingCountsForPngOnlyAsInPbrt) {
+  TempDir d("encoding");
+  d.write("a.exr", "x"); // only its existence is checked while loading
+  Scene s = load_pbrt_scene_from_string(
+      kHead +
+          "Texture \"e\" \"spectrum\" \"imagemap\" \"string filename\" \"a.exr\" \"string "
+          "encoding\" \"sRGB\"\nMaterial \"diffuse\" \"texture reflectance\" \"e\"\n" +
+          kTri,
+      "t.pbrt", d.dir, {});
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].encoding, ImageEncoding::Auto);
+}
+
+TEST(SceneTexturesPbrt, RoughnessTexturesMapToAlpha) {
+  Scene s = load(
+      kHead + kRoughTex + kWood + "Material \"conductor\" \"texture roughness\" \"r\"\n" + kTri +
+      "Material \"conductor\" \"texture roughness\" \"r\" \"bool remaproughness\" false\n" + kTri +
+      "Material \"coateddiffuse\" \"texture reflectance\" \"wood\" \"texture uroughness\" \"r\" "
+      "\"texture vroughness\" \"r\"\n" +
+      kTri + "Material \"conductor\" \"texture roughness\" \"r\"\n" + kTri);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  // r with remapping, r without, wood; the fourth material reuses the first texture.
+  ASSERT_EQ(s.textures.size(), 3u);
+  EXPECT_EQ(s.textures[0].file, kRough);
+  EXPECT_EQ(s.textures[0].channels, 1);
+  EXPECT_EQ(s.textures[0].map, TEXTURE_MAP_ALPHA_SQRT);
+  EXPECT_EQ(s.textures[0].where, "t.pbrt:5: texture \"r\"");
+  EXPECT_EQ(s.textures[1].channels, 1);
+  EXPECT_EQ(s.textures[1].map, TEXTURE_MAP_VALUE);
+  EXPECT_EQ(s.textures[2].channels, 3);
+  EXPECT_EQ(s.textures[2].file, kChecker);
+  const Material &a = material_of(s, 0), &b = material_of(s, 1), &c = material_of(s, 2),
+                 &e = material_of(s, 3);
+  EXPECT_EQ(a.type, MATERIAL_CONDUCTOR);
+  EXPECT_EQ(a.alpha_texture, 1);
+  EXPECT_EQ(a.albedo_texture, 0);
+  EXPECT_EQ(b.alpha_texture, 2);
+  EXPECT_EQ(c.type, MATERIAL_PLASTIC);
+  EXPECT_EQ(c.alpha_texture, 1);
+  EXPECT_EQ(c.albedo_texture, 3);
+  EXPECT_EQ(e.alpha_texture, 1);
+}
+
+TEST(SceneTexturesPbrt, AnisotropicRoughnessTexturesWarnAndUseURoughness) {
+  const std::string text = kHead + kRoughTex +
+                           "Texture \"r2\" \"float\" \"imagemap\" \"string filename\" "
+                           "\"textures/checker.png\"\nMaterial \"conductor\"\n  \"texture "
+                           "uroughness\" \"r2\" \"texture vroughness\" \"r\"\n" +
+                           kTri;
+  Scene s = load(text);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0],
+            "t.pbrt:8: Material \"conductor\": uroughness and vroughness differ: Canopy's GGX is "
+            "isotropic, the texture \"r2\" used, anisotropy ignored");
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].file, kChecker);
+  EXPECT_EQ(material_of(s, 0).alpha_texture, 1);
+  EXPECT_EQ(error_of(text, true), s.warnings[0] + " (--strict: warnings are errors)");
+}
+
+TEST(SceneTexturesPbrt, ScaleAndConstantTexturesFold) {
+  Scene s =
+      load(kHead + kWood + kRoughTex +
+           "Texture \"half\" \"spectrum\" \"scale\" \"texture tex\" \"wood\" \"float scale\" "
+           "0.5\nTexture \"q\" \"float\" \"constant\" \"float value\" 0.25\nTexture \"rs\" "
+           "\"float\" \"scale\" \"texture tex\" \"q\" \"texture scale\" \"r\"\nTexture \"c\" "
+           "\"spectrum\" \"constant\" \"rgb value\" [0.2 0.3 0.4]\nTexture \"c2\" \"spectrum\" "
+           "\"scale\" \"texture tex\" \"c\" \"texture scale\" \"q\"\nMaterial \"coateddiffuse\" "
+           "\"texture reflectance\" \"half\" \"texture roughness\" \"rs\"\n" +
+           kTri + "Material \"diffuse\" \"texture reflectance\" \"c\"\n" + kTri +
+           "Material \"conductor\" \"texture roughness\" \"q\"\n" + kTri +
+           "Material \"diffuse\" \"texture reflectance\" \"c2\"\n" + kTri);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  ASSERT_EQ(s.textures.size(), 2u);
+  // The scaled reflectance first (the material reads it first), then the roughness.
+  EXPECT_EQ(s.textures[0].file, kChecker);
+  EXPECT_FLOAT_EQ(s.textures[0].scale.x, 0.5f);
+  EXPECT_FLOAT_EQ(s.textures[0].scale.z, 0.5f);
+  EXPECT_EQ(s.textures[0].where, "t.pbrt:7: texture \"half\"");
+  EXPECT_EQ(s.textures[1].file, kRough);
+  EXPECT_FLOAT_EQ(s.textures[1].scale.x, 0.25f);
+  EXPECT_EQ(s.textures[1].where, "t.pbrt:9: texture \"rs\"");
+  const Material& a = material_of(s, 0);
+  EXPECT_EQ(a.albedo_texture, 1);
+  EXPECT_EQ(a.alpha_texture, 2);
+  const Material& b = material_of(s, 1);
+  EXPECT_EQ(b.albedo_texture, 0);
+  EXPECT_FLOAT_EQ(b.albedo.x, 0.2f);
+  EXPECT_FLOAT_EQ(b.albedo.y, 0.3f);
+  EXPECT_FLOAT_EQ(b.albedo.z, 0.4f);
+  const Material& c = material_of(s, 2); // roughness 0.25, remapped: alpha = sqrt(0.25)
+  EXPECT_EQ(c.alpha_texture, 0);
+  EXPECT_NEAR(c.alpha, 0.5f, 1e-6f);
+  const Material& e = material_of(s, 3);
+  EXPECT_FLOAT_EQ(e.albedo.x, 0.05f);
+  EXPECT_FLOAT_EQ(e.albedo.z, 0.1f);
+}
+
+TEST(SceneTexturesPbrt, TexturesAreGlobalAcrossAttributes) {
+  Scene s = load(kHead + "AttributeBegin\n" + kWood + "AttributeEnd\n" +
+                 "Material \"diffuse\" \"texture reflectance\" \"wood\"\n" + kTri);
+  EXPECT_EQ(material_of(s, 0).albedo_texture, 1);
+}
+
+TEST(SceneTexturesPbrt, UnsupportedClassesWarnOnceAndKeepTheDefault) {
+  const std::string text =
+      kHead + "Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 4\n" +
+      "Texture \"f\" \"float\" \"fbm\"\n" +
+      "Material \"coateddiffuse\" \"texture reflectance\" \"t\" \"texture roughness\" \"f\"\n" +
+      kTri;
+  Scene s = load(text);
+  ASSERT_EQ(s.warnings.size(), 2u);
+  EXPECT_EQ(s.warnings[0], "t.pbrt:5: Texture \"t\": the texture class \"checkerboard\" is not "
+                           "supported (a material using it keeps its constant default), ignored");
+  EXPECT_EQ(s.warnings[1].rfind("t.pbrt:6: Texture \"f\": the texture class \"fbm\"", 0), 0u);
+  EXPECT_TRUE(s.textures.empty());
+  const Material& m = material_of(s, 0);
+  EXPECT_EQ(m.albedo_texture, 0);
+  EXPECT_EQ(m.alpha_texture, 0);
+  EXPECT_FLOAT_EQ(m.albedo.x, 0.5f);
+  EXPECT_FLOAT_EQ(m.alpha, 0.0f);
+  EXPECT_EQ(error_of(text, true), s.warnings[0] + " (--strict: warnings are errors)");
+}
+
+TEST(SceneTexturesPbrt, ParametersCanopyCannotRenderWarnWithFileAndLine) {
+  struct Case {
+    std::string params, want;
+  };
+  const Case cases[] = {
+      {"\"bool invert\" true",
+       "t.pbrt:6: Texture \"w\": \"bool invert\" true (1 - value) is not supported, ignored"},
+      {"\"string filter\" \"ewa\" \"float maxanisotropy\" 16",
+       "t.pbrt:6: Texture \"w\": \"string filter\" \"ewa\" (maxanisotropy 16): Canopy filters "
+       "bilinearly, ignored"},
+      {"\"string mapping\" \"planar\" \"vector3 v1\" [1 0 0]",
+       "t.pbrt:6: Texture \"w\": \"string mapping\" \"planar\": only \"uv\" mapping is supported "
+       "(uv used), ignored"},
+      {"\"float frobnicate\" 1",
+       "t.pbrt:6: Texture \"w\": unknown parameter \"float frobnicate\" ignored"},
+  };
+  for (const Case& c : cases) {
+    const std::string text =
+        kHead +
+        "Texture \"w\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\"\n  " +
+        c.params + "\n";
+    Scene s = load(text);
+    ASSERT_EQ(s.warnings.size(), 1u) << c.params;
+    EXPECT_EQ(s.warnings[0], c.want);
+    EXPECT_EQ(error_of(text, true), c.want + " (--strict: warnings are errors)");
+  }
+}
+
+TEST(SceneTexturesPbrt, ConductorReflectanceImageWarnsAndFallsBack) {
+  Scene s =
+      load(kHead + kWood + "Material \"conductor\" \"texture reflectance\" \"wood\"\n" + kTri);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0].rfind("t.pbrt:6: Material \"conductor\": \"texture reflectance\" "
+                                "\"wood\": Canopy's conductor takes no reflectance image",
+                                0),
+            0u)
+      << s.warnings[0];
+  EXPECT_TRUE(s.textures.empty());
+  EXPECT_NEAR(material_of(s, 0).specular.x, 0.238f, 1e-6f); // copper
+}
+
+TEST(SceneTexturesPbrt, ErrorsAreOneLineNamingFileAndLine) {
+  const std::string tex = "Texture \"w\" \"spectrum\" \"imagemap\" \"string filename\" ";
+  struct Case {
+    std::string text, want;
+  };
+  const Case cases[] = {
+      {tex + "\"textures/none.png\"\n", "t.pbrt:5: Texture \"w\": \"string filename\" " +
+                                            (kData / "textures/none.png").string() +
+                                            ": no such file"},
+      {tex + "\"textures\"\n", "t.pbrt:5: Texture \"w\": \"string filename\" " +
+                                   (kData / "textures").string() + ": no such file"},
+      {"Texture \"w\" \"spectrum\" \"imagemap\"\n",
+       "t.pbrt:5: Texture \"w\": needs \"string filename\""},
+      {tex + "\"textures/checker.png\"\n \"string wrap\" \"mirror\"\n",
+       "t.pbrt:6: Texture \"w\": \"string wrap\" \"mirror\": unknown wrap mode (want \"repeat\", "
+       "\"clamp\" or \"black\")"},
+      {tex + "\"textures/checker.png\" \"string encoding\" \"gamma 0\"\n",
+       "t.pbrt:5: Texture \"w\": \"string encoding\" \"gamma 0\": unknown encoding (want \"sRGB\", "
+       "\"linear\" or \"gamma <value>\" with a value > 0)"},
+      {tex + "\"textures/checker.png\" \"float scale\" -1\n",
+       "t.pbrt:5: Texture \"w\": \"float scale\": must be >= 0 and a finite float"},
+      {"Texture \"w\" \"color\" \"imagemap\"\n",
+       "t.pbrt:5: Texture \"w\": texture type \"color\" unknown (want \"float\" or \"spectrum\")"},
+      {"Texture \"w\" \"spectrum\"\n", "t.pbrt:5: Texture: expected a quoted name"},
+      {kWood + kWood, "t.pbrt:6: Texture \"wood\": the spectrum texture \"wood\" is defined twice"},
+      {"Material \"diffuse\" \"texture reflectance\" \"nothing\"\n",
+       "t.pbrt:5: Material \"diffuse\": \"texture reflectance\": no spectrum texture named "
+       "\"nothing\""},
+      {kRoughTex + "Material \"diffuse\" \"texture reflectance\" \"r\"\n",
+       "t.pbrt:6: Material \"diffuse\": \"texture reflectance\": no spectrum texture named \"r\" "
+       "(\"r\" is a float texture)"},
+      {kWood + "Material \"conductor\" \"texture roughness\" \"wood\"\n",
+       "t.pbrt:6: Material \"conductor\": \"texture roughness\": no float texture named \"wood\" "
+       "(\"wood\" is a spectrum texture)"},
+  };
+  for (const Case& c : cases) {
+    std::string e = error_of(kHead + c.text);
+    EXPECT_EQ(e, c.want);
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+  EXPECT_EQ(error_of("Texture \"w\" \"spectrum\" \"imagemap\"\n"),
+            "t.pbrt:1: Texture is not allowed before WorldBegin");
+}
 
 // --------------------------------------------------------------------------------- pbrt uv
 
