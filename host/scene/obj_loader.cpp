@@ -1,6 +1,7 @@
 // OBJ + MTL meshes via tinyobjloader. An MTL material becomes a diffuse or plastic material named
 // after it (mtl_to_material: Kd, Ks, Ns, Ni, illum); MTL Ke > 0 makes the material's triangles
-// emitters (radiance Ke). Vertex normals (vn) become shading normals.
+// emitters (radiance Ke); map_Kd makes an albedo texture (mtl_albedo_texture). Vertex normals (vn)
+// become shading normals, texture coordinates (vt) the mesh's uv.
 #include "scene/loader_internal.h"
 
 #include <fmt/format.h>
@@ -117,8 +118,11 @@ public:
                                        fmt::format("{}{}: ", prefix_, printable(mat_id, 256)));
     std::istringstream in(text);
     tinyobj::LoadMtl(mat_map, materials, &in, warn, err);
+    files.resize(materials->size(), p);
     return true;
   }
+  // The MTL file of each material read so far (map_Kd names are relative to its directory).
+  std::vector<std::filesystem::path> files;
 
 private:
   std::filesystem::path dir_;
@@ -169,6 +173,40 @@ template <class Fail> MaterialDesc mtl_to_material(const tinyobj::material_t& mt
     fail(fmt::format("material '{}': Ni must be <= {}", mname, kMaxPlasticIor));
   float ior = mt.ior > 1.0f ? float(mt.ior) : kDefaultPlasticIor;
   return plastic_material(mt.name, kd, ks, roughness_from_ns(double(mt.shininess)), ior);
+}
+
+// The albedo texture of an MTL material's map_Kd (empty name: none), relative to the directory of
+// its MTL file `mtl`. As in pbrt's and Cycles' importers, the map replaces Kd (Kd only matters
+// where the map is absent). The options tinyobjloader parses that Canopy can express: -s (scale of
+// u, v), -o (offset of u, v), i.e. (s, t) = (s_u u + o_u, s_v v + o_v), -clamp on
+// (TEXTURE_WRAP_CLAMP), and the "-colorspace sRGB|linear" extension; the others (-bm, -mm, -t,
+// -texres, -imfchan, -blendu/v, -boost) are ignored. `fail` reports a problem with the material.
+template <class Fail>
+TextureDesc mtl_albedo_texture(const tinyobj::material_t& mt, const std::filesystem::path& mtl,
+                               Fail fail) {
+  const std::string mname = printable(mt.name);
+  std::filesystem::path file(mt.diffuse_texname);
+  if (file.is_relative()) file = mtl.parent_path() / file;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    fail(fmt::format("{}: material '{}': map_Kd '{}': no such file",
+                     printable(mtl.filename().string(), 256), mname,
+                     printable(file.string(), 1024)));
+  const tinyobj::texture_option_t& o = mt.diffuse_texopt;
+  TextureDesc t;
+  t.file = file;
+  t.where = fmt::format("{}: material '{}': map_Kd", printable(mtl.string(), 1024), mname);
+  t.channels = 3;
+  t.uvmap = make_float4(o.scale[0], o.scale[1], o.origin_offset[0], o.origin_offset[1]);
+  if (!std::isfinite(t.uvmap.x + t.uvmap.y + t.uvmap.z + t.uvmap.w))
+    fail(fmt::format("{}: material '{}': map_Kd: -s and -o must be finite",
+                     printable(mtl.filename().string(), 256), mname));
+  t.wrap = o.clamp ? TEXTURE_WRAP_CLAMP : TEXTURE_WRAP_REPEAT;
+  if (o.colorspace == "sRGB")
+    t.encoding = ImageEncoding::Srgb;
+  else if (o.colorspace == "linear")
+    t.encoding = ImageEncoding::Linear;
+  return t;
 }
 
 } // namespace
@@ -237,6 +275,13 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     if (!finite_nonneg3(mt.emission))
       mtl_fail(fmt::format("material '{}': Ke must be >= 0", printable(mt.name)));
     mat_emission[i] = make_float3(mt.emission[0], mt.emission[1], mt.emission[2]);
+    // A texture only for a material this OBJ adds (not one the scene replaces or one already
+    // added), so nothing unused is read at render time.
+    if (material_override < 0 && !mt.diffuse_texname.empty() && !b.material_by_name.count(d.name) &&
+        !b.mtl_material_by_key.count(name + "\n" + d.name))
+      d.gpu.albedo_texture = add_texture(
+          b.scene, mtl_albedo_texture(mt, i < mtl_reader.files.size() ? mtl_reader.files[i] : dir,
+                                      mtl_fail));
     mat_index[i] = material_override < 0 ? b.mtl_material(name, d) : material_override;
   }
 
