@@ -39,8 +39,10 @@ std::string error_of(const std::string& text, bool strict = false) {
 
 // The frames agree with Canopy's (Scale -1 1 1), so the world is kept as written. Three lines: the
 // scene text starts at line 4 with "WorldBegin".
-const std::string kHead =
-    "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n";
+const std::string kHead = "Scale -1 1 1\n"
+                          "LookAt 0 0 5  0 0 0  0 1 0\n"
+                          "Camera \"perspective\"\n"
+                          "WorldBegin\n";
 
 const std::string kTri =
     "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer indices\" [0 1 2]\n";
@@ -94,14 +96,14 @@ struct TempDir {
 // ---------------------------------------------------------------------------- pbrt Texture
 
 TEST(SceneTexturesPbrt, ImagemapFieldsAndTheMaterialsIndex) {
-  Scene s =
-      load(kHead +
-           "Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" "
-           "\"textures/checker.png\"\n  \"string wrap\" \"clamp\" \"float scale\" 0.5 \"string "
-           "encoding\" \"gamma 2.2\"\n  \"float uscale\" 2 \"float vscale\" 3 \"float udelta\" "
-           "0.25 \"float vdelta\" -0.5 \"string filter\" \"bilinear\" \"float maxanisotropy\" "
-           "4\nMaterial \"diffuse\" \"texture reflectance\" \"wood\"\n" +
-           kTri);
+  Scene s = load(
+      kHead +
+      "Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\"\n"
+      "  \"string wrap\" \"clamp\" \"float scale\" 0.5 \"string encoding\" \"gamma 2.2\"\n"
+      "  \"float uscale\" 2 \"float vscale\" 3 \"float udelta\" 0.25 \"float vdelta\" -0.5 "
+      "\"string filter\" \"bilinear\" \"float maxanisotropy\" 4\n"
+      "Material \"diffuse\" \"texture reflectance\" \"wood\"\n" +
+      kTri);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
   ASSERT_EQ(s.textures.size(), 1u);
   const TextureDesc& t = s.textures[0];
@@ -126,14 +128,15 @@ TEST(SceneTexturesPbrt, ImagemapFieldsAndTheMaterialsIndex) {
 }
 
 TEST(SceneTexturesPbrt, DefaultsWrapModesAndEncodings) {
-  Scene s = load(
-      kHead + kWood +
-      "Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\" "
-      "\"string wrap\" \"black\" \"string encoding\" \"sRGB\"\nTexture \"l\" \"spectrum\" "
-      "\"imagemap\" \"string filename\" \"textures/checker.png\" \"string wrap\" \"repeat\" "
-      "\"string encoding\" \"linear\"\nMaterial \"diffuse\" \"texture reflectance\" \"wood\"\n" +
-      kTri + "Material \"diffuse\" \"texture reflectance\" \"b\"\n" + kTri +
-      "Material \"diffuse\" \"texture reflectance\" \"l\"\n" + kTri);
+  Scene s =
+      load(kHead + kWood +
+           "Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\" "
+           "\"string wrap\" \"black\" \"string encoding\" \"sRGB\"\n"
+           "Texture \"l\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\" "
+           "\"string wrap\" \"repeat\" \"string encoding\" \"linear\"\n"
+           "Material \"diffuse\" \"texture reflectance\" \"wood\"\n" +
+           kTri + "Material \"diffuse\" \"texture reflectance\" \"b\"\n" + kTri +
+           "Material \"diffuse\" \"texture reflectance\" \"l\"\n" + kTri);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
   ASSERT_EQ(s.textures.size(), 3u);
   EXPECT_EQ(s.textures[0].wrap, TEXTURE_WRAP_REPEAT);
@@ -155,12 +158,12 @@ TEST(SceneTexturesPbrt, DefaultsWrapModesAndEncodings) {
 TEST(SceneTexturesPbrt, EncodingCountsForPngOnlyAsInPbrt) {
   TempDir d("encoding");
   d.write("a.exr", "x"); // only its existence is checked while loading
-  Scene s = load_pbrt_scene_from_string(
-      kHead +
-          "Texture \"e\" \"spectrum\" \"imagemap\" \"string filename\" \"a.exr\" \"string "
-          "encoding\" \"sRGB\"\nMaterial \"diffuse\" \"texture reflectance\" \"e\"\n" +
-          kTri,
-      "t.pbrt", d.dir, {});
+  Scene s = load_pbrt_scene_from_string(kHead +
+                                            "Texture \"e\" \"spectrum\" \"imagemap\" \"string "
+                                            "filename\" \"a.exr\" \"string encoding\" \"sRGB\"\n"
+                                            "Material \"diffuse\" \"texture reflectance\" \"e\"\n" +
+                                            kTri,
+                                        "t.pbrt", d.dir, {});
   ASSERT_EQ(s.textures.size(), 1u);
   EXPECT_EQ(s.textures[0].encoding, ImageEncoding::Auto);
 }
@@ -196,11 +199,12 @@ TEST(SceneTexturesPbrt, RoughnessTexturesMapToAlpha) {
 }
 
 TEST(SceneTexturesPbrt, AnisotropicRoughnessTexturesWarnAndUseURoughness) {
-  const std::string text = kHead + kRoughTex +
-                           "Texture \"r2\" \"float\" \"imagemap\" \"string filename\" "
-                           "\"textures/checker.png\"\nMaterial \"conductor\"\n  \"texture "
-                           "uroughness\" \"r2\" \"texture vroughness\" \"r\"\n" +
-                           kTri;
+  const std::string text =
+      kHead + kRoughTex +
+      "Texture \"r2\" \"float\" \"imagemap\" \"string filename\" \"textures/checker.png\"\n"
+      "Material \"conductor\"\n"
+      "  \"texture uroughness\" \"r2\" \"texture vroughness\" \"r\"\n" +
+      kTri;
   Scene s = load(text);
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_EQ(s.warnings[0],
@@ -213,17 +217,17 @@ TEST(SceneTexturesPbrt, AnisotropicRoughnessTexturesWarnAndUseURoughness) {
 }
 
 TEST(SceneTexturesPbrt, ScaleAndConstantTexturesFold) {
-  Scene s =
-      load(kHead + kWood + kRoughTex +
-           "Texture \"half\" \"spectrum\" \"scale\" \"texture tex\" \"wood\" \"float scale\" "
-           "0.5\nTexture \"q\" \"float\" \"constant\" \"float value\" 0.25\nTexture \"rs\" "
-           "\"float\" \"scale\" \"texture tex\" \"q\" \"texture scale\" \"r\"\nTexture \"c\" "
-           "\"spectrum\" \"constant\" \"rgb value\" [0.2 0.3 0.4]\nTexture \"c2\" \"spectrum\" "
-           "\"scale\" \"texture tex\" \"c\" \"texture scale\" \"q\"\nMaterial \"coateddiffuse\" "
-           "\"texture reflectance\" \"half\" \"texture roughness\" \"rs\"\n" +
-           kTri + "Material \"diffuse\" \"texture reflectance\" \"c\"\n" + kTri +
-           "Material \"conductor\" \"texture roughness\" \"q\"\n" + kTri +
-           "Material \"diffuse\" \"texture reflectance\" \"c2\"\n" + kTri);
+  Scene s = load(
+      kHead + kWood + kRoughTex +
+      "Texture \"half\" \"spectrum\" \"scale\" \"texture tex\" \"wood\" \"float scale\" 0.5\n"
+      "Texture \"q\" \"float\" \"constant\" \"float value\" 0.25\n"
+      "Texture \"rs\" \"float\" \"scale\" \"texture tex\" \"q\" \"texture scale\" \"r\"\n"
+      "Texture \"c\" \"spectrum\" \"constant\" \"rgb value\" [0.2 0.3 0.4]\n"
+      "Texture \"c2\" \"spectrum\" \"scale\" \"texture tex\" \"c\" \"texture scale\" \"q\"\n"
+      "Material \"coateddiffuse\" \"texture reflectance\" \"half\" \"texture roughness\" \"rs\"\n" +
+      kTri + "Material \"diffuse\" \"texture reflectance\" \"c\"\n" + kTri +
+      "Material \"conductor\" \"texture roughness\" \"q\"\n" + kTri +
+      "Material \"diffuse\" \"texture reflectance\" \"c2\"\n" + kTri);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
   ASSERT_EQ(s.textures.size(), 2u);
   // The scaled reflectance first (the material reads it first), then the roughness.
@@ -295,7 +299,8 @@ TEST(SceneTexturesPbrt, ParametersCanopyCannotRenderWarnWithFileAndLine) {
   for (const Case& c : cases) {
     const std::string text =
         kHead +
-        "Texture \"w\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\"\n  " +
+        "Texture \"w\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\"\n"
+        "  " +
         c.params + "\n";
     Scene s = load(text);
     ASSERT_EQ(s.warnings.size(), 1u) << c.params;
@@ -330,7 +335,8 @@ TEST(SceneTexturesPbrt, ErrorsAreOneLineNamingFileAndLine) {
                                    (kData / "textures").string() + ": no such file"},
       {"Texture \"w\" \"spectrum\" \"imagemap\"\n",
        "t.pbrt:5: Texture \"w\": needs \"string filename\""},
-      {tex + "\"textures/checker.png\"\n \"string wrap\" \"mirror\"\n",
+      {tex + "\"textures/checker.png\"\n"
+             " \"string wrap\" \"mirror\"\n",
        "t.pbrt:6: Texture \"w\": \"string wrap\" \"mirror\": unknown wrap mode (want \"repeat\", "
        "\"clamp\" or \"black\")"},
       {tex + "\"textures/checker.png\" \"string encoding\" \"gamma 0\"\n",
@@ -364,11 +370,11 @@ TEST(SceneTexturesPbrt, ErrorsAreOneLineNamingFileAndLine) {
 // --------------------------------------------------------------------------------- pbrt uv
 
 TEST(SceneTexturesPbrt, TriangleMeshUvAndDefaultsForMeshesWithout) {
-  Scene s =
-      load(kHead + kTri +
-           "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0] \"integer indices\" "
-           "[0 1 2  2 1 3]\n  \"point2 uv\" [0.1 0.2  0.3 0.4  0.5 0.6  0.7 0.8]\n" +
-           kTri);
+  Scene s = load(kHead + kTri +
+                 "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0] \"integer "
+                 "indices\" [0 1 2  2 1 3]\n"
+                 "  \"point2 uv\" [0.1 0.2  0.3 0.4  0.5 0.6  0.7 0.8]\n" +
+                 kTri);
   ASSERT_EQ(s.triangle_count(), 4u);
   ASSERT_EQ(s.triangle_uvs.size(), 12u);
   expect_uv(s, 0, {0, 0, 1, 0, 1, 1}); // before the first mesh with uv: the default
@@ -382,11 +388,12 @@ TEST(SceneTexturesPbrt, UvCountMustMatchTheVertexCount) {
     std::string text, want;
   };
   const Case cases[] = {
-      {"Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0]\n  \"point2 uv\" [0 0  1 0]\n",
+      {"Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0]\n"
+       "  \"point2 uv\" [0 0  1 0]\n",
        "t.pbrt:6: Shape \"trianglemesh\": \"point2 uv\": wrong count of values (4; want 6, one "
        "pair per vertex)"},
-      {"Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n  \"point2 uv\" [0 0 1 0 "
-       "0 1 1 1 2 2]\n",
+      {"Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n"
+       "  \"point2 uv\" [0 0 1 0 0 1 1 1 2 2]\n",
        "t.pbrt:6: Shape \"bilinearmesh\": \"point2 uv\": wrong count of values (10; want 8, one "
        "pair per vertex)"},
   };
@@ -427,9 +434,9 @@ TEST(SceneTexturesPbrt, UvFollowTheWindingWhenItIsReversed) {
 
 TEST(SceneTexturesPbrt, BilinearMeshUvGivenAndDefault) {
   Scene s = load(kHead + kLeadTri +
-                 "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\nShape "
-                 "\"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n  \"point2 uv\" [0.1 "
-                 "0.2  0.3 0.4  0.5 0.6  0.7 0.8]\n");
+                 "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n"
+                 "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n"
+                 "  \"point2 uv\" [0.1 0.2  0.3 0.4  0.5 0.6  0.7 0.8]\n");
   ASSERT_EQ(s.triangle_count(), kLead + 4);
   // pbrt-v4's default for a patch: (u, v) of its own parameterisation at p00 p10 p01 p11.
   expect_uv(s, kLead, {0, 0, 1, 0, 1, 1});
@@ -491,29 +498,48 @@ TEST(SceneTexturesPbrt, SphereUvIsPbrtsParameterisationWithASeam) {
 }
 
 TEST(SceneTexturesPbrt, ReversedSphereAndDiskUv) {
-  Scene s = load(kHead + kLeadTri + "ReverseOrientation\nShape \"sphere\"\n");
+  Scene s = load(kHead + kLeadTri +
+                 "ReverseOrientation\n"
+                 "Shape \"sphere\"\n");
   expect_polar_uv(s, true, 1.0);
   expect_uv(s, kLead, {0.5f / 48, 1, 1.0f / 48, 1 - 1.0f / 24, 0, 1 - 1.0f / 24});
   Scene d = load(kHead + kLeadTri + "Shape \"disk\" \"float radius\" 3\n");
   expect_polar_uv(d, false, 3.0);
   expect_uv(d, kLead + 63, {63.5f / 64, 1, 63.0f / 64, 0, 1, 0});
-  Scene r = load(kHead + kLeadTri + "Scale 1 -1 1\nShape \"disk\" \"float radius\" 3\n");
+  Scene r = load(kHead + kLeadTri +
+                 "Scale 1 -1 1\n"
+                 "Shape \"disk\" \"float radius\" 3\n");
   ASSERT_EQ(r.triangle_uvs.size(), 3 * (kLead + 64));
   expect_uv(r, kLead + 63, {63.5f / 64, 1, 1, 0, 63.0f / 64, 0});
 }
 
 TEST(SceneTexturesPbrt, PlyMeshUvAndObjectInstances) {
   TempDir d("ply");
-  d.write("uv.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float "
-                    "y\nproperty float z\nproperty float u\nproperty float v\nelement face "
-                    "1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0.1 0.2\n1 0 0 "
-                    "0.3 0.4\n1 1 0 0.5 0.6\n0 1 0 0.7 0.8\n4 0 1 2 3\n");
-  Scene s =
-      load_pbrt_scene_from_string(kHead + kLeadTri +
-                                      "ObjectBegin \"o\"\nShape \"plymesh\" \"string filename\" "
-                                      "\"uv.ply\"\nObjectEnd\nObjectInstance \"o\"\nTranslate 0 0 "
-                                      "1\nReverseOrientation\nObjectInstance \"o\"\n",
-                                  "t.pbrt", d.dir, {});
+  d.write("uv.ply", "ply\n"
+                    "format ascii 1.0\n"
+                    "element vertex 4\n"
+                    "property float x\n"
+                    "property float y\n"
+                    "property float z\n"
+                    "property float u\n"
+                    "property float v\n"
+                    "element face 1\n"
+                    "property list uchar int vertex_indices\n"
+                    "end_header\n"
+                    "0 0 0 0.1 0.2\n"
+                    "1 0 0 0.3 0.4\n"
+                    "1 1 0 0.5 0.6\n"
+                    "0 1 0 0.7 0.8\n"
+                    "4 0 1 2 3\n");
+  Scene s = load_pbrt_scene_from_string(kHead + kLeadTri +
+                                            "ObjectBegin \"o\"\n"
+                                            "Shape \"plymesh\" \"string filename\" \"uv.ply\"\n"
+                                            "ObjectEnd\n"
+                                            "ObjectInstance \"o\"\n"
+                                            "Translate 0 0 1\n"
+                                            "ReverseOrientation\n"
+                                            "ObjectInstance \"o\"\n",
+                                        "t.pbrt", d.dir, {});
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
   ASSERT_EQ(s.triangle_count(), kLead + 4);
   expect_uv(s, kLead, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
@@ -529,7 +555,10 @@ namespace {
 
 // `shapes` is the JSON array's content after a first OBJ triangle without uv (kLead).
 Scene load_json(const TempDir& d, const std::string& shapes, const std::string& extra = "") {
-  d.write("lead.obj", "v 0 0 -1\nv 1 0 -1\nv 0 1 -1\nf 1 2 3\n");
+  d.write("lead.obj", "v 0 0 -1\n"
+                      "v 1 0 -1\n"
+                      "v 0 1 -1\n"
+                      "f 1 2 3\n");
   std::string json = R"({"camera": {"position": [0, 1, 5], "look_at": [0, 1, 0]},)" + extra +
                      R"("shapes": [{"type": "obj", "file": "lead.obj"}, )" + shapes + "]" +
                      R"(, "lights": [{"type": "point", "position": [0, 2, 0], "intensity": 1}]})";
@@ -549,8 +578,17 @@ std::string json_error(const TempDir& d, const std::string& shapes) {
 
 TEST(SceneTexturesObj, VtBecomeUvAndFacesWithoutVtTheDefault) {
   TempDir d("obj-vt");
-  d.write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0.1 0.2\nvt 0.3 0.4\nvt 0.5 0.6 0.9\nf "
-                   "1 2 3\nf 1/1 2/2 3/3\nf 2/2 4/3 3/1\nf 1 2/1 3/2\n");
+  d.write("m.obj", "v 0 0 0\n"
+                   "v 1 0 0\n"
+                   "v 0 1 0\n"
+                   "v 1 1 0\n"
+                   "vt 0.1 0.2\n"
+                   "vt 0.3 0.4\n"
+                   "vt 0.5 0.6 0.9\n"
+                   "f 1 2 3\n"
+                   "f 1/1 2/2 3/3\n"
+                   "f 2/2 4/3 3/1\n"
+                   "f 1 2/1 3/2\n");
   Scene s = load_json(d, R"({"type": "obj", "file": "m.obj"})");
   ASSERT_EQ(s.triangle_count(), kLead + 4);
   expect_uv(s, kLead, {0, 0, 1, 0, 1, 1});
@@ -561,7 +599,11 @@ TEST(SceneTexturesObj, VtBecomeUvAndFacesWithoutVtTheDefault) {
   Scene m = load_json(d, R"({"type": "obj", "file": "m.obj", "transform": {"scale": [-1, 1, 1]}})");
   expect_uv(m, kLead + 1, {0.1f, 0.2f, 0.5f, 0.6f, 0.3f, 0.4f});
   // A vt index out of range is an error.
-  d.write("n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/4\n");
+  d.write("n.obj", "v 0 0 0\n"
+                   "v 1 0 0\n"
+                   "v 0 1 0\n"
+                   "vt 0 0\n"
+                   "f 1/1 2/1 3/4\n");
   EXPECT_EQ(json_error(d, R"({"type": "obj", "file": "n.obj"})"),
             "scene.json: shapes[1].file: n.obj: face 1 of '' has a texture coordinate index out of "
             "range");
@@ -570,15 +612,31 @@ TEST(SceneTexturesObj, VtBecomeUvAndFacesWithoutVtTheDefault) {
 TEST(SceneTexturesObj, MapKdIsAnAlbedoTextureWithItsOptions) {
   TempDir d("obj-map");
   std::filesystem::create_directories(d.dir / "mtl" / "tex");
-  d.write("mtl/tex/wood.png",
-          "x"); // only its existence is checked while loading
-  // tinyobjloader reads three numbers after -s and -o (u v w: v and w are not optional there).
-  d.write("mtl/m.mtl", "newmtl plain\nKd 0.2 0.3 0.4\nnewmtl wood\nKd 0.2 0.3 0.4\nmap_Kd -s 2 3 1 "
-                       "-o 0.25 0.5 0 -clamp on -bm 2 tex/wood.png\nnewmtl shiny\nKd 1 1 1\nKs 0.5 "
-                       "0.5 0.5\nNs 100\nillum 2\nmap_Kd -colorspace linear tex/wood.png\n");
-  d.write("m.obj",
-          "mtllib mtl/m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl plain\nf "
-          "1/1 2/2 3/3\nusemtl wood\nf 1/1 2/2 3/3\nusemtl shiny\nf 1/1 2/2 3/3\n");
+  d.write("mtl/tex/wood.png", "x"); // only its existence is checked while loading
+  d.write("mtl/m.mtl", "newmtl plain\n"
+                       "Kd 0.2 0.3 0.4\n"
+                       "newmtl wood\n"
+                       "Kd 0.2 0.3 0.4\n"
+                       "map_Kd -s 2 3 -o 0.25 0.5 -clamp on -bm 2 tex/wood.png\n"
+                       "newmtl shiny\n"
+                       "Kd 1 1 1\n"
+                       "Ks 0.5 0.5 0.5\n"
+                       "Ns 100\n"
+                       "illum 2\n"
+                       "map_Kd -colorspace linear -o 0.5 -s 4 tex/wood.png\n");
+  d.write("m.obj", "mtllib mtl/m.mtl\n"
+                   "v 0 0 0\n"
+                   "v 1 0 0\n"
+                   "v 0 1 0\n"
+                   "vt 0 0\n"
+                   "vt 1 0\n"
+                   "vt 0 1\n"
+                   "usemtl plain\n"
+                   "f 1/1 2/2 3/3\n"
+                   "usemtl wood\n"
+                   "f 1/1 2/2 3/3\n"
+                   "usemtl shiny\n"
+                   "f 1/1 2/2 3/3\n");
   Scene s = load_json(d, R"({"type": "obj", "file": "m.obj"})");
   ASSERT_EQ(s.textures.size(), 2u);
   const TextureDesc& t = s.textures[0];
@@ -594,8 +652,12 @@ TEST(SceneTexturesObj, MapKdIsAnAlbedoTextureWithItsOptions) {
   EXPECT_FLOAT_EQ(t.scale.x, 1.0f);
   EXPECT_EQ(s.textures[1].wrap, TEXTURE_WRAP_REPEAT);
   EXPECT_EQ(s.textures[1].encoding, ImageEncoding::Linear);
-  EXPECT_FLOAT_EQ(s.textures[1].uvmap.x, 1.0f);
-  EXPECT_FLOAT_EQ(s.textures[1].uvmap.z, 0.0f);
+  // -s and -o with fewer than three numbers: the others take their defaults, the name stays.
+  EXPECT_EQ(s.textures[1].file, d.dir / "mtl" / "tex" / "wood.png");
+  EXPECT_FLOAT_EQ(s.textures[1].uvmap.x, 4.0f);
+  EXPECT_FLOAT_EQ(s.textures[1].uvmap.y, 1.0f);
+  EXPECT_FLOAT_EQ(s.textures[1].uvmap.z, 0.5f);
+  EXPECT_FLOAT_EQ(s.textures[1].uvmap.w, 0.0f);
   EXPECT_EQ(material_of(s, kLead).albedo_texture, 0);
   EXPECT_EQ(material_of(s, kLead + 1).albedo_texture, 1);
   EXPECT_EQ(material_of(s, kLead + 1).type, MATERIAL_DIFFUSE);
@@ -620,8 +682,15 @@ TEST(SceneTexturesObj, MapKdIsAnAlbedoTextureWithItsOptions) {
 
 TEST(SceneTexturesObj, MissingMapKdFileIsAnErrorNamingTheMtlAndTheMap) {
   TempDir d("obj-missing");
-  d.write("m.mtl", "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd nothing.png\n");
-  d.write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl wood\nf 1 2 3\n");
+  d.write("m.mtl", "newmtl wood\n"
+                   "Kd 0.5 0.5 0.5\n"
+                   "map_Kd nothing.png\n");
+  d.write("m.obj", "mtllib m.mtl\n"
+                   "v 0 0 0\n"
+                   "v 1 0 0\n"
+                   "v 0 1 0\n"
+                   "usemtl wood\n"
+                   "f 1 2 3\n");
   std::string e = json_error(d, R"({"type": "obj", "file": "m.obj"})");
   EXPECT_EQ(e, "scene.json: shapes[1].file: m.obj: m.mtl: material 'wood': map_Kd '" +
                    (d.dir / "nothing.png").string() + "': no such file");

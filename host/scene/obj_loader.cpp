@@ -100,6 +100,81 @@ void check_mtllibs(const std::string& text, const std::filesystem::path& dir,
   }
 }
 
+// tinyobjloader reads exactly three numbers after a texture map's -s, -o and -t, and two after
+// -mm, taking the next words whatever they are: "map_Kd -s 2 2 wood.png" loses its file name to
+// the third scale. The MTL format makes the second and third optional, so map_Kd lines get the
+// missing ones (-s: 1, -o and -t: 0; -mm: gain 1) before tinyobjloader reads them. The file name
+// (the rest of the line after the options, spaces included) is kept as it is.
+std::string pad_map_kd_options(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  auto is_number = [](std::string_view t) {
+    if (t.size() > 1 && t[0] == '+') t.remove_prefix(1);
+    double d = 0.0;
+    auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), d);
+    return !t.empty() && ec == std::errc() && end == t.data() + t.size();
+  };
+  for (size_t pos = 0; pos < text.size();) {
+    size_t eol = text.find('\n', pos);
+    if (eol == std::string::npos) eol = text.size();
+    std::string_view line(text.data() + pos, eol - pos);
+    pos = eol + 1;
+    const bool newline = eol < text.size();
+    size_t i = line.find_first_not_of(" \t");
+    if (i == std::string_view::npos || line.substr(i, 6) != "map_Kd" ||
+        (i + 6 < line.size() && line[i + 6] != ' ' && line[i + 6] != '\t')) {
+      out.append(line);
+      if (newline) out.push_back('\n');
+      continue;
+    }
+    out.append(line.substr(0, i + 6));
+    size_t k = i + 6;
+    // The next word from k (k moves past it); empty at the end of the line.
+    auto word = [&](size_t& at) {
+      at = line.find_first_not_of(" \t\r", at);
+      if (at == std::string_view::npos) at = line.size();
+      size_t e = line.find_first_of(" \t\r", at);
+      if (e == std::string_view::npos) e = line.size();
+      std::string_view w = line.substr(at, e - at);
+      at = e;
+      return w;
+    };
+    while (true) {
+      size_t start = k;
+      std::string_view opt = word(k);
+      if (opt.empty() || opt[0] != '-') { // the file name: the rest of the line as it is
+        out.append(line.substr(start));
+        break;
+      }
+      out.push_back(' ');
+      out.append(opt);
+      int want = (opt == "-s" || opt == "-o" || opt == "-t") ? 3 : opt == "-mm" ? 2 : -1;
+      if (want < 0) { // an option of one word (-clamp on, -bm 1, ...), or an unknown one
+        if (opt == "-blendu" || opt == "-blendv" || opt == "-clamp" || opt == "-boost" ||
+            opt == "-bm" || opt == "-texres" || opt == "-imfchan" || opt == "-type" ||
+            opt == "-colorspace") {
+          out.push_back(' ');
+          out.append(word(k));
+        }
+        continue;
+      }
+      int have = 0;
+      for (; have < want; ++have) {
+        size_t at = k;
+        std::string_view v = word(at);
+        if (!is_number(v)) break;
+        k = at;
+        out.push_back(' ');
+        out.append(v);
+      }
+      for (; have < want; ++have)
+        out.append(opt == "-s" || (opt == "-mm" && have == 1) ? " 1" : " 0");
+    }
+    if (newline) out.push_back('\n');
+  }
+  return out;
+}
+
 // Reads MTL files through read_input_file (regular files under the size limit only).
 class CheckedMaterialReader : public tinyobj::MaterialReader {
 public:
@@ -116,7 +191,7 @@ public:
     }
     std::string text = read_input_file(p, kMaxMtlFileBytes,
                                        fmt::format("{}{}: ", prefix_, printable(mat_id, 256)));
-    std::istringstream in(text);
+    std::istringstream in(pad_map_kd_options(text));
     tinyobj::LoadMtl(mat_map, materials, &in, warn, err);
     files.resize(materials->size(), p);
     return true;
