@@ -641,7 +641,7 @@ TEST(SceneTexturesObj, MapKdIsAnAlbedoTextureWithItsOptions) {
   ASSERT_EQ(s.textures.size(), 2u);
   const TextureDesc& t = s.textures[0];
   EXPECT_EQ(t.file, d.dir / "mtl" / "tex" / "wood.png");
-  EXPECT_EQ(t.where, (d.dir / "mtl/m.mtl").string() + ": material 'wood': map_Kd");
+  EXPECT_EQ(t.where, "scene.json: shapes[1].file: m.obj: mtl/m.mtl: material 'wood': map_Kd");
   EXPECT_EQ(t.channels, 3);
   EXPECT_EQ(t.encoding, ImageEncoding::Auto);
   EXPECT_FLOAT_EQ(t.uvmap.x, 2.0f);

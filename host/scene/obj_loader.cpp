@@ -194,10 +194,13 @@ public:
     std::istringstream in(pad_map_kd_options(text));
     tinyobj::LoadMtl(mat_map, materials, &in, warn, err);
     files.resize(materials->size(), p);
+    names.resize(materials->size(), mat_id);
     return true;
   }
-  // The MTL file of each material read so far (map_Kd names are relative to its directory).
+  // The MTL file of each material read so far (map_Kd names are relative to its directory),
+  // and its name as the mtllib line gives it (for messages).
   std::vector<std::filesystem::path> files;
+  std::vector<std::string> names;
 
 private:
   std::filesystem::path dir_;
@@ -255,27 +258,26 @@ template <class Fail> MaterialDesc mtl_to_material(const tinyobj::material_t& mt
 // where the map is absent). The options tinyobjloader parses that Canopy can express: -s (scale of
 // u, v), -o (offset of u, v), i.e. (s, t) = (s_u u + o_u, s_v v + o_v), -clamp on
 // (TEXTURE_WRAP_CLAMP), and the "-colorspace sRGB|linear" extension; the others (-bm, -mm, -t,
-// -texres, -imfchan, -blendu/v, -boost) are ignored. `fail` reports a problem with the material.
+// -texres, -imfchan, -blendu/v, -boost) are ignored. `where` starts the texture's messages (the
+// JSON value naming the OBJ, the OBJ and the MTL name), `fail` reports a problem with the
+// material.
 template <class Fail>
 TextureDesc mtl_albedo_texture(const tinyobj::material_t& mt, const std::filesystem::path& mtl,
-                               Fail fail) {
-  const std::string mname = printable(mt.name);
+                               const std::string& where, Fail fail) {
+  const std::string what = fmt::format("material '{}': map_Kd", printable(mt.name));
   std::filesystem::path file(mt.diffuse_texname);
   if (file.is_relative()) file = mtl.parent_path() / file;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
-    fail(fmt::format("{}: material '{}': map_Kd '{}': no such file",
-                     printable(mtl.filename().string(), 256), mname,
-                     printable(file.string(), 1024)));
+    fail(fmt::format("{} '{}': no such file", what, printable(file.string(), 1024)));
   const tinyobj::texture_option_t& o = mt.diffuse_texopt;
   TextureDesc t;
   t.file = file;
-  t.where = fmt::format("{}: material '{}': map_Kd", printable(mtl.string(), 1024), mname);
+  t.where = where + what;
   t.channels = 3;
   t.uvmap = make_float4(o.scale[0], o.scale[1], o.origin_offset[0], o.origin_offset[1]);
   if (!std::isfinite(t.uvmap.x + t.uvmap.y + t.uvmap.z + t.uvmap.w))
-    fail(fmt::format("{}: material '{}': map_Kd: -s and -o must be finite",
-                     printable(mtl.filename().string(), 256), mname));
+    fail(what + ": -s and -o must be finite");
   t.wrap = o.clamp ? TEXTURE_WRAP_CLAMP : TEXTURE_WRAP_REPEAT;
   if (o.colorspace == "sRGB")
     t.encoding = ImageEncoding::Srgb;
@@ -353,10 +355,15 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     // A texture only for a material this OBJ adds (not one the scene replaces or one already
     // added), so nothing unused is read at render time.
     if (material_override < 0 && !mt.diffuse_texname.empty() && !b.material_by_name.count(d.name) &&
-        !b.mtl_material_by_key.count(name + "\n" + d.name))
+        !b.mtl_material_by_key.count(name + "\n" + d.name)) {
+      const bool known = i < mtl_reader.files.size();
+      const std::string mtl_name = printable(known ? mtl_reader.names[i] : std::string("?"), 256);
       d.gpu.albedo_texture = add_texture(
-          b.scene, mtl_albedo_texture(mt, i < mtl_reader.files.size() ? mtl_reader.files[i] : dir,
-                                      mtl_fail));
+          b.scene, mtl_albedo_texture(
+                       mt, known ? mtl_reader.files[i] : dir / "?",
+                       fmt::format("{}: {}: {}: {}: ", at.file(), at.path(), name, mtl_name),
+                       [&](const std::string& problem) { mtl_fail(mtl_name + ": " + problem); }));
+    }
     mat_index[i] = material_override < 0 ? b.mtl_material(name, d) : material_override;
   }
 
