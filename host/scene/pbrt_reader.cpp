@@ -1,11 +1,13 @@
 // pbrt-v4 scene files (https://pbrt.org/fileformat-v4; "the format page" below): tokenizer,
 // attribute/transform state, Include/Import, object instances (flattened), the perspective camera,
 // film/sampler/integrator settings, triangle/bilinear meshes, PLY meshes (plymesh, read by
-// ply_mesh.cpp), spheres and disks, point/spot/diffuse area lights, and
-// diffuse/conductor/coateddiffuse materials. Everything else is skipped with a one-line warning
-// naming file:line (docs/scene-format.md, "pbrt-v4 scenes"). The result is the same canopy::Scene
-// the JSON loader builds: geometry goes through Builder::add_mesh (transformed in double, rebased
-// to the camera position, rounded once) and lights through the helpers of lights.cpp.
+// ply_mesh.cpp) with their uv, spheres and disks, point/spot/diffuse area lights,
+// diffuse/conductor/coateddiffuse materials, and image textures (imagemap, constant, scale) for
+// their reflectance and roughness. Everything else is skipped with a one-line warning naming
+// file:line (docs/scene-format.md, "pbrt-v4 scenes"; docs/pbrt-scenes.md, "Image textures"). The
+// result is the same canopy::Scene the JSON loader builds: geometry goes through Builder::add_mesh
+// (transformed in double, rebased to the camera position, rounded once) and lights through the
+// helpers of lights.cpp.
 #include "scene/pbrt_reader.h"
 
 #include "scene/loader_internal.h"
