@@ -615,6 +615,8 @@ TEST(SceneTexturesObj, MapKdIsAnAlbedoTextureWithItsOptions) {
   d.write("mtl/tex/wood.png", "x"); // only its existence is checked while loading
   d.write("mtl/m.mtl", "newmtl plain\n"
                        "Kd 0.2 0.3 0.4\n"
+                       "map_Pr tex/wood.png\n" // a diffuse material has no roughness
+
                        "newmtl wood\n"
                        "Kd 0.2 0.3 0.4\n"
                        "map_Kd -s 2 3 -o 0.25 0.5 -clamp on -bm 2 tex/wood.png\n"
@@ -623,7 +625,8 @@ TEST(SceneTexturesObj, MapKdIsAnAlbedoTextureWithItsOptions) {
                        "Ks 0.5 0.5 0.5\n"
                        "Ns 100\n"
                        "illum 2\n"
-                       "map_Kd -colorspace linear -o 0.5 -s 4 tex/wood.png\n");
+                       "map_Kd -colorspace linear -o 0.5 -s 4 tex/wood.png\n"
+                       "map_Pr -s 2 tex/wood.png\n");
   d.write("m.obj", "mtllib mtl/m.mtl\n"
                    "v 0 0 0\n"
                    "v 1 0 0\n"
@@ -638,7 +641,7 @@ TEST(SceneTexturesObj, MapKdIsAnAlbedoTextureWithItsOptions) {
                    "usemtl shiny\n"
                    "f 1/1 2/2 3/3\n");
   Scene s = load_json(d, R"({"type": "obj", "file": "m.obj"})");
-  ASSERT_EQ(s.textures.size(), 2u);
+  ASSERT_EQ(s.textures.size(), 3u);
   const TextureDesc& t = s.textures[0];
   EXPECT_EQ(t.file, d.dir / "mtl" / "tex" / "wood.png");
   EXPECT_EQ(t.where, "scene.json: shapes[1].file: m.obj: mtl/m.mtl: material 'wood': map_Kd");
@@ -662,17 +665,26 @@ TEST(SceneTexturesObj, MapKdIsAnAlbedoTextureWithItsOptions) {
   EXPECT_EQ(material_of(s, kLead + 1).albedo_texture, 1);
   EXPECT_EQ(material_of(s, kLead + 1).type, MATERIAL_DIFFUSE);
   EXPECT_EQ(material_of(s, kLead + 2).albedo_texture, 2);
+  // map_Pr of the plastic: its roughness (Canopy's: alpha = r^2).
+  EXPECT_EQ(material_of(s, kLead + 2).alpha_texture, 3);
+  EXPECT_EQ(material_of(s, kLead).alpha_texture, 0);
+  EXPECT_EQ(s.textures[2].channels, 1);
+  EXPECT_EQ(s.textures[2].map, TEXTURE_MAP_ALPHA_SQUARE);
+  EXPECT_EQ(s.textures[2].where,
+            "scene.json: shapes[1].file: m.obj: mtl/m.mtl: material 'shiny': map_Pr");
+  EXPECT_FLOAT_EQ(s.textures[2].uvmap.x, 2.0f);
+  EXPECT_FLOAT_EQ(s.textures[2].uvmap.y, 1.0f);
   EXPECT_EQ(material_of(s, kLead + 2).type, MATERIAL_PLASTIC);
 
   // The same OBJ twice: its materials, and so their textures, are added once.
   Scene twice =
       load_json(d, R"({"type": "obj", "file": "m.obj"}, {"type": "obj", "file": "m.obj"})");
-  EXPECT_EQ(twice.textures.size(), 2u);
+  EXPECT_EQ(twice.textures.size(), 3u);
   EXPECT_EQ(material_of(twice, kLead + 4).albedo_texture, 1);
   // A scene material of the same name replaces the MTL one: no texture.
   Scene named = load_json(d, R"({"type": "obj", "file": "m.obj"})",
                           R"("materials": [{"name": "wood", "type": "diffuse", "albedo": 0.5}],)");
-  EXPECT_EQ(named.textures.size(), 1u);
+  EXPECT_EQ(named.textures.size(), 2u);
   EXPECT_EQ(material_of(named, kLead + 1).albedo_texture, 0);
   // A material override replaces every MTL material: no texture.
   Scene over = load_json(d, R"({"type": "obj", "file": "m.obj", "material": "grey"})",

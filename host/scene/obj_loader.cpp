@@ -1,7 +1,8 @@
 // OBJ + MTL meshes via tinyobjloader. An MTL material becomes a diffuse or plastic material named
 // after it (mtl_to_material: Kd, Ks, Ns, Ni, illum); MTL Ke > 0 makes the material's triangles
-// emitters (radiance Ke); map_Kd makes an albedo texture (mtl_albedo_texture). Vertex normals (vn)
-// become shading normals, texture coordinates (vt) the mesh's uv.
+// emitters (radiance Ke); map_Kd makes an albedo texture, map_Pr a roughness texture of a plastic
+// (mtl_texture). Vertex normals (vn) become shading normals, texture coordinates (vt) the mesh's
+// uv.
 #include "scene/loader_internal.h"
 
 #include <fmt/format.h>
@@ -102,10 +103,10 @@ void check_mtllibs(const std::string& text, const std::filesystem::path& dir,
 
 // tinyobjloader reads exactly three numbers after a texture map's -s, -o and -t, and two after
 // -mm, taking the next words whatever they are: "map_Kd -s 2 2 wood.png" loses its file name to
-// the third scale. The MTL format makes the second and third optional, so map_Kd lines get the
-// missing ones (-s: 1, -o and -t: 0; -mm: gain 1) before tinyobjloader reads them. The file name
-// (the rest of the line after the options, spaces included) is kept as it is.
-std::string pad_map_kd_options(const std::string& text) {
+// the third scale. The MTL format makes the second and third optional, so map_Kd and map_Pr lines
+// get the missing ones (-s: 1, -o and -t: 0; -mm: gain 1) before tinyobjloader reads them. The
+// file name (the rest of the line after the options, spaces included) is kept as it is.
+std::string pad_map_options(const std::string& text) {
   std::string out;
   out.reserve(text.size());
   auto is_number = [](std::string_view t) {
@@ -121,7 +122,8 @@ std::string pad_map_kd_options(const std::string& text) {
     pos = eol + 1;
     const bool newline = eol < text.size();
     size_t i = line.find_first_not_of(" \t");
-    if (i == std::string_view::npos || line.substr(i, 6) != "map_Kd" ||
+    if (i == std::string_view::npos ||
+        (line.substr(i, 6) != "map_Kd" && line.substr(i, 6) != "map_Pr") ||
         (i + 6 < line.size() && line[i + 6] != ' ' && line[i + 6] != '\t')) {
       out.append(line);
       if (newline) out.push_back('\n');
@@ -191,7 +193,7 @@ public:
     }
     std::string text = read_input_file(p, kMaxMtlFileBytes,
                                        fmt::format("{}{}: ", prefix_, printable(mat_id, 256)));
-    std::istringstream in(pad_map_kd_options(text));
+    std::istringstream in(pad_map_options(text));
     tinyobj::LoadMtl(mat_map, materials, &in, warn, err);
     files.resize(materials->size(), p);
     names.resize(materials->size(), mat_id);
@@ -253,28 +255,26 @@ template <class Fail> MaterialDesc mtl_to_material(const tinyobj::material_t& mt
   return plastic_material(mt.name, kd, ks, roughness_from_ns(double(mt.shininess)), ior);
 }
 
-// The albedo texture of an MTL material's map_Kd (empty name: none), relative to the directory of
-// its MTL file `mtl`. As in pbrt's and Cycles' importers, the map replaces Kd (Kd only matters
-// where the map is absent). The options tinyobjloader parses that Canopy can express: -s (scale of
-// u, v), -o (offset of u, v), i.e. (s, t) = (s_u u + o_u, s_v v + o_v), -clamp on
-// (TEXTURE_WRAP_CLAMP), and the "-colorspace sRGB|linear" extension; the others (-bm, -mm, -t,
-// -texres, -imfchan, -blendu/v, -boost) are ignored. `where` starts the texture's messages (the
-// JSON value naming the OBJ, the OBJ and the MTL name), `fail` reports a problem with the
+// The texture of an MTL material's map `key` (map_Kd, map_Pr; file name `texname`, options `o`),
+// relative to the directory of its MTL file `mtl`. The options tinyobjloader parses that Canopy can
+// express: -s (scale of u, v), -o (offset of u, v), i.e. (s, t) = (s_u u + o_u, s_v v + o_v),
+// -clamp on (TEXTURE_WRAP_CLAMP), and the "-colorspace sRGB|linear" extension; the others (-bm,
+// -mm, -t, -texres, -imfchan, -blendu/v, -boost) are ignored. `where` starts the texture's messages
+// (the JSON value naming the OBJ, the OBJ and the MTL name), `fail` reports a problem with the
 // material.
 template <class Fail>
-TextureDesc mtl_albedo_texture(const tinyobj::material_t& mt, const std::filesystem::path& mtl,
-                               const std::string& where, Fail fail) {
-  const std::string what = fmt::format("material '{}': map_Kd", printable(mt.name));
-  std::filesystem::path file(mt.diffuse_texname);
+TextureDesc mtl_texture(const tinyobj::material_t& mt, const char* key, const std::string& texname,
+                        const tinyobj::texture_option_t& o, const std::filesystem::path& mtl,
+                        const std::string& where, Fail fail) {
+  const std::string what = fmt::format("material '{}': {}", printable(mt.name), key);
+  std::filesystem::path file(texname);
   if (file.is_relative()) file = mtl.parent_path() / file;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
     fail(fmt::format("{} '{}': no such file", what, printable(file.string(), 1024)));
-  const tinyobj::texture_option_t& o = mt.diffuse_texopt;
   TextureDesc t;
   t.file = file;
   t.where = where + what;
-  t.channels = 3;
   t.uvmap = make_float4(o.scale[0], o.scale[1], o.origin_offset[0], o.origin_offset[1]);
   if (!std::isfinite(t.uvmap.x + t.uvmap.y + t.uvmap.z + t.uvmap.w))
     fail(what + ": -s and -o must be finite");
@@ -352,17 +352,33 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     if (!finite_nonneg3(mt.emission))
       mtl_fail(fmt::format("material '{}': Ke must be >= 0", printable(mt.name)));
     mat_emission[i] = make_float3(mt.emission[0], mt.emission[1], mt.emission[2]);
-    // A texture only for a material this OBJ adds (not one the scene replaces or one already
-    // added), so nothing unused is read at render time.
-    if (material_override < 0 && !mt.diffuse_texname.empty() && !b.material_by_name.count(d.name) &&
-        !b.mtl_material_by_key.count(name + "\n" + d.name)) {
+    // Textures only for a material this OBJ adds (not one the scene replaces or one already
+    // added), so nothing unused is read at render time. map_Kd: as in pbrt's and Cycles'
+    // importers, the map replaces Kd (Kd only matters where the map is absent). map_Pr (the PBR
+    // extension's roughness, which tinyobjloader reads): for a plastic, the roughness map
+    // replacing the one of Ns, Canopy's roughness (alpha = r^2: TEXTURE_MAP_ALPHA_SQUARE); a
+    // diffuse material has no roughness, so it ignores map_Pr.
+    const bool plastic = d.gpu.type == MATERIAL_PLASTIC;
+    if (material_override < 0 &&
+        (!mt.diffuse_texname.empty() || (plastic && !mt.roughness_texname.empty())) &&
+        !b.material_by_name.count(d.name) && !b.mtl_material_by_key.count(name + "\n" + d.name)) {
       const bool known = i < mtl_reader.files.size();
       const std::string mtl_name = printable(known ? mtl_reader.names[i] : std::string("?"), 256);
-      d.gpu.albedo_texture = add_texture(
-          b.scene, mtl_albedo_texture(
-                       mt, known ? mtl_reader.files[i] : dir / "?",
-                       fmt::format("{}: {}: {}: {}: ", at.file(), at.path(), name, mtl_name),
-                       [&](const std::string& problem) { mtl_fail(mtl_name + ": " + problem); }));
+      const std::filesystem::path mtl = known ? mtl_reader.files[i] : dir / "?";
+      const std::string where =
+          fmt::format("{}: {}: {}: {}: ", at.file(), at.path(), name, mtl_name);
+      auto fail = [&](const std::string& problem) { mtl_fail(mtl_name + ": " + problem); };
+      if (!mt.diffuse_texname.empty())
+        d.gpu.albedo_texture =
+            add_texture(b.scene, mtl_texture(mt, "map_Kd", mt.diffuse_texname, mt.diffuse_texopt,
+                                             mtl, where, fail));
+      if (plastic && !mt.roughness_texname.empty()) {
+        TextureDesc t =
+            mtl_texture(mt, "map_Pr", mt.roughness_texname, mt.roughness_texopt, mtl, where, fail);
+        t.channels = 1;
+        t.map = TEXTURE_MAP_ALPHA_SQUARE;
+        d.gpu.alpha_texture = add_texture(b.scene, std::move(t));
+      }
     }
     mat_index[i] = material_override < 0 ? b.mtl_material(name, d) : material_override;
   }
