@@ -214,6 +214,14 @@ canopy_cli_test(cli_pbrt_render_plymesh
 canopy_cli_test(cli_pbrt_plymesh_truncated -DSCENE=${CANOPY_PBRT_DATA}/ply_truncated.pbrt
   "-DEXPECT=${CANOPY_PBRT_DATA}/ply_truncated.pbrt:5: Shape \"plymesh\" \"${CANOPY_PBRT_DATA}/truncated.ply\": truncated: the file ends in vertex 2 of 3 (189 bytes)"
   -P ${CANOPY_CHECK2})
+# A textured scene renders (image textures for reflectance and roughness, read at render time);
+# a texture whose file is missing is exit 2 with one line naming file:line.
+canopy_cli_test(cli_pbrt_render_textured
+  "-DARGS=render|${CANOPY_PBRT_DATA}/textured.pbrt|--spp|1|--quiet|--out|${CANOPY_SCRATCH}/pbrt_textured.exr"
+  "-DNOT_STDERR=warning" "-DFILES=${CANOPY_SCRATCH}/pbrt_textured.exr" -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_pbrt_texture_missing -DSCENE=${CANOPY_PBRT_DATA}/texture_missing.pbrt
+  "-DEXPECT=${CANOPY_PBRT_DATA}/texture_missing.pbrt:4: Texture \"wood\": \"string filename\" ${CANOPY_PBRT_DATA}/textures/no_such.png: no such file"
+  -P ${CANOPY_CHECK2})
 # An Include cycle: exit 2, the cycle named.
 canopy_cli_test(cli_pbrt_include_cycle -DSCENE=${CANOPY_PBRT_DATA}/cycle_a.pbrt
   "-DEXPECT=${CANOPY_PBRT_DATA}/cycle_b.pbrt:2: Include cycle: ${CANOPY_PBRT_DATA}/cycle_a.pbrt -> ${CANOPY_PBRT_DATA}/cycle_b.pbrt -> ${CANOPY_PBRT_DATA}/cycle_a.pbrt"

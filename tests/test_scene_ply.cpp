@@ -348,6 +348,16 @@ TEST(ScenePly, OutOfRangeIndicesOfPolygonsAreErrorsBeforeAssimp) {
               std::string::npos)
         << e;
   }
+  // A face without vertices: Assimp's triangulation aborted on it (an assertion; found by the
+  // fuzzer: an ASCII face line "0").
+  for (Enc enc : {Enc::Ascii, Enc::LittleEndian, Enc::BigEndian}) {
+    Ply p = kQuadAndTriangle;
+    p.faces.push_back({});
+    p.faces.push_back({0, 1, 2});
+    write(d / "e.ply", ply_bytes(p, enc));
+    std::string e = error_of(d / "e.ply");
+    EXPECT_NE(e.find("face 3 of 4: a face without vertices"), std::string::npos) << e;
+  }
   // The fuzzer's reproduction: a polygon whose count and indices are vertex bytes.
   Ply shifted = kQuadAndTriangle;
   shifted.faces[0] = {0, 1, 2, 3, 4, 0x3e99999a};

@@ -1,6 +1,8 @@
 // OBJ + MTL meshes via tinyobjloader. An MTL material becomes a diffuse or plastic material named
 // after it (mtl_to_material: Kd, Ks, Ns, Ni, illum); MTL Ke > 0 makes the material's triangles
-// emitters (radiance Ke). Vertex normals (vn) become shading normals.
+// emitters (radiance Ke); map_Kd makes an albedo texture, map_Pr a roughness texture of a plastic
+// (mtl_texture). Vertex normals (vn) become shading normals, texture coordinates (vt) the mesh's
+// uv.
 #include "scene/loader_internal.h"
 
 #include <fmt/format.h>
@@ -99,6 +101,82 @@ void check_mtllibs(const std::string& text, const std::filesystem::path& dir,
   }
 }
 
+// tinyobjloader reads exactly three numbers after a texture map's -s, -o and -t, and two after
+// -mm, taking the next words whatever they are: "map_Kd -s 2 2 wood.png" loses its file name to
+// the third scale. The MTL format makes the second and third optional, so map_Kd and map_Pr lines
+// get the missing ones (-s: 1, -o and -t: 0; -mm: gain 1) before tinyobjloader reads them. The
+// file name (the rest of the line after the options, spaces included) is kept as it is.
+std::string pad_map_options(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  auto is_number = [](std::string_view t) {
+    if (t.size() > 1 && t[0] == '+') t.remove_prefix(1);
+    double d = 0.0;
+    auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), d);
+    return !t.empty() && ec == std::errc() && end == t.data() + t.size();
+  };
+  for (size_t pos = 0; pos < text.size();) {
+    size_t eol = text.find('\n', pos);
+    if (eol == std::string::npos) eol = text.size();
+    std::string_view line(text.data() + pos, eol - pos);
+    pos = eol + 1;
+    const bool newline = eol < text.size();
+    size_t i = line.find_first_not_of(" \t");
+    if (i == std::string_view::npos ||
+        (line.substr(i, 6) != "map_Kd" && line.substr(i, 6) != "map_Pr") ||
+        (i + 6 < line.size() && line[i + 6] != ' ' && line[i + 6] != '\t')) {
+      out.append(line);
+      if (newline) out.push_back('\n');
+      continue;
+    }
+    out.append(line.substr(0, i + 6));
+    size_t k = i + 6;
+    // The next word from k (k moves past it); empty at the end of the line.
+    auto word = [&](size_t& at) {
+      at = line.find_first_not_of(" \t\r", at);
+      if (at == std::string_view::npos) at = line.size();
+      size_t e = line.find_first_of(" \t\r", at);
+      if (e == std::string_view::npos) e = line.size();
+      std::string_view w = line.substr(at, e - at);
+      at = e;
+      return w;
+    };
+    while (true) {
+      size_t start = k;
+      std::string_view opt = word(k);
+      if (opt.empty() || opt[0] != '-') { // the file name: the rest of the line as it is
+        out.append(line.substr(start));
+        break;
+      }
+      out.push_back(' ');
+      out.append(opt);
+      int want = (opt == "-s" || opt == "-o" || opt == "-t") ? 3 : opt == "-mm" ? 2 : -1;
+      if (want < 0) { // an option of one word (-clamp on, -bm 1, ...), or an unknown one
+        if (opt == "-blendu" || opt == "-blendv" || opt == "-clamp" || opt == "-boost" ||
+            opt == "-bm" || opt == "-texres" || opt == "-imfchan" || opt == "-type" ||
+            opt == "-colorspace") {
+          out.push_back(' ');
+          out.append(word(k));
+        }
+        continue;
+      }
+      int have = 0;
+      for (; have < want; ++have) {
+        size_t at = k;
+        std::string_view v = word(at);
+        if (!is_number(v)) break;
+        k = at;
+        out.push_back(' ');
+        out.append(v);
+      }
+      for (; have < want; ++have)
+        out.append(opt == "-s" || (opt == "-mm" && have == 1) ? " 1" : " 0");
+    }
+    if (newline) out.push_back('\n');
+  }
+  return out;
+}
+
 // Reads MTL files through read_input_file (regular files under the size limit only).
 class CheckedMaterialReader : public tinyobj::MaterialReader {
 public:
@@ -115,10 +193,16 @@ public:
     }
     std::string text = read_input_file(p, kMaxMtlFileBytes,
                                        fmt::format("{}{}: ", prefix_, printable(mat_id, 256)));
-    std::istringstream in(text);
+    std::istringstream in(pad_map_options(text));
     tinyobj::LoadMtl(mat_map, materials, &in, warn, err);
+    files.resize(materials->size(), p);
+    names.resize(materials->size(), mat_id);
     return true;
   }
+  // The MTL file of each material read so far (map_Kd names are relative to its directory),
+  // and its name as the mtllib line gives it (for messages).
+  std::vector<std::filesystem::path> files;
+  std::vector<std::string> names;
 
 private:
   std::filesystem::path dir_;
@@ -171,6 +255,37 @@ template <class Fail> MaterialDesc mtl_to_material(const tinyobj::material_t& mt
   return plastic_material(mt.name, kd, ks, roughness_from_ns(double(mt.shininess)), ior);
 }
 
+// The texture of an MTL material's map `key` (map_Kd, map_Pr; file name `texname`, options `o`),
+// relative to the directory of its MTL file `mtl`. The options tinyobjloader parses that Canopy can
+// express: -s (scale of u, v), -o (offset of u, v), i.e. (s, t) = (s_u u + o_u, s_v v + o_v),
+// -clamp on (TEXTURE_WRAP_CLAMP), and the "-colorspace sRGB|linear" extension; the others (-bm,
+// -mm, -t, -texres, -imfchan, -blendu/v, -boost) are ignored. `where` starts the texture's messages
+// (the JSON value naming the OBJ, the OBJ and the MTL name), `fail` reports a problem with the
+// material.
+template <class Fail>
+TextureDesc mtl_texture(const tinyobj::material_t& mt, const char* key, const std::string& texname,
+                        const tinyobj::texture_option_t& o, const std::filesystem::path& mtl,
+                        const std::string& where, Fail fail) {
+  const std::string what = fmt::format("material '{}': {}", printable(mt.name), key);
+  std::filesystem::path file(texname);
+  if (file.is_relative()) file = mtl.parent_path() / file;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    fail(fmt::format("{} '{}': no such file", what, printable(file.string(), 1024)));
+  TextureDesc t;
+  t.file = file;
+  t.where = where + what;
+  t.uvmap = make_float4(o.scale[0], o.scale[1], o.origin_offset[0], o.origin_offset[1]);
+  if (!std::isfinite(t.uvmap.x + t.uvmap.y + t.uvmap.z + t.uvmap.w))
+    fail(what + ": -s and -o must be finite");
+  t.wrap = o.clamp ? TEXTURE_WRAP_CLAMP : TEXTURE_WRAP_REPEAT;
+  if (o.colorspace == "sRGB")
+    t.encoding = ImageEncoding::Srgb;
+  else if (o.colorspace == "linear")
+    t.encoding = ImageEncoding::Linear;
+  return t;
+}
+
 } // namespace
 
 Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b,
@@ -219,6 +334,12 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     m.normals[i] =
         make_float3(attrib.normals[3 * i], attrib.normals[3 * i + 1], attrib.normals[3 * i + 2]);
 
+  // Texture coordinates as given (check_obj_text has refused non-finite numbers).
+  size_t nt = attrib.texcoords.size() / 2;
+  m.uvs.resize(nt);
+  for (size_t i = 0; i < nt; ++i)
+    m.uvs[i] = make_float2(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]);
+
   // Materials of the MTL, resolved once.
   std::vector<int> mat_index(materials.size(), 0);
   std::vector<float3> mat_emission(materials.size(), make_float3(0, 0, 0));
@@ -231,10 +352,38 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
     if (!finite_nonneg3(mt.emission))
       mtl_fail(fmt::format("material '{}': Ke must be >= 0", printable(mt.name)));
     mat_emission[i] = make_float3(mt.emission[0], mt.emission[1], mt.emission[2]);
+    // Textures only for a material this OBJ adds (not one the scene replaces or one already
+    // added), so nothing unused is read at render time. map_Kd: as in pbrt's and Cycles'
+    // importers, the map replaces Kd (Kd only matters where the map is absent). map_Pr (the PBR
+    // extension's roughness, which tinyobjloader reads): for a plastic, the roughness map
+    // replacing the one of Ns, Canopy's roughness (alpha = r^2: TEXTURE_MAP_ALPHA_SQUARE); a
+    // diffuse material has no roughness, so it ignores map_Pr.
+    const bool plastic = d.gpu.type == MATERIAL_PLASTIC;
+    if (material_override < 0 &&
+        (!mt.diffuse_texname.empty() || (plastic && !mt.roughness_texname.empty())) &&
+        !b.material_by_name.count(d.name) && !b.mtl_material_by_key.count(name + "\n" + d.name)) {
+      const bool known = i < mtl_reader.files.size();
+      const std::string mtl_name = printable(known ? mtl_reader.names[i] : std::string("?"), 256);
+      const std::filesystem::path mtl = known ? mtl_reader.files[i] : dir / "?";
+      const std::string where =
+          fmt::format("{}: {}: {}: {}: ", at.file(), at.path(), name, mtl_name);
+      auto fail = [&](const std::string& problem) { mtl_fail(mtl_name + ": " + problem); };
+      if (!mt.diffuse_texname.empty())
+        d.gpu.albedo_texture =
+            add_texture(b.scene, mtl_texture(mt, "map_Kd", mt.diffuse_texname, mt.diffuse_texopt,
+                                             mtl, where, fail));
+      if (plastic && !mt.roughness_texname.empty()) {
+        TextureDesc t =
+            mtl_texture(mt, "map_Pr", mt.roughness_texname, mt.roughness_texopt, mtl, where, fail);
+        t.channels = 1;
+        t.map = TEXTURE_MAP_ALPHA_SQUARE;
+        d.gpu.alpha_texture = add_texture(b.scene, std::move(t));
+      }
+    }
     mat_index[i] = material_override < 0 ? b.mtl_material(name, d) : material_override;
   }
 
-  bool any_normals = false;
+  bool any_normals = false, any_uv = false;
   for (const auto& sh : shapes) {
     const auto& mesh = sh.mesh;
     size_t nf = mesh.num_face_vertices.size();
@@ -243,8 +392,8 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
         at.fail(fmt::format("{}: face {} of '{}' is not a triangle after triangulation", name,
                             f + 1, printable(sh.name)));
       uint32_t idx[3];
-      int32_t nidx[3];
-      bool has_normals = true;
+      int32_t nidx[3], tidx[3];
+      bool has_normals = true, has_uv = true;
       for (int k = 0; k < 3; ++k) {
         int vi = mesh.indices[3 * f + k].vertex_index;
         if (vi < 0 || size_t(vi) >= nv)
@@ -257,6 +406,12 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
                               printable(sh.name)));
         nidx[k] = ni;
         has_normals = has_normals && ni >= 0;
+        int ti = mesh.indices[3 * f + k].texcoord_index; // -1: the face gives no uv
+        if (ti >= 0 && size_t(ti) >= nt)
+          at.fail(fmt::format("{}: face {} of '{}' has a texture coordinate index out of range",
+                              name, f + 1, printable(sh.name)));
+        tidx[k] = ti;
+        has_uv = has_uv && ti >= 0;
       }
       // normal_indices starts at the first triangle with normals (earlier ones: -1).
       if (has_normals && !any_normals) m.normal_indices.assign(3 * m.triangle_count(), -1);
@@ -264,6 +419,12 @@ Mesh load_obj(const std::filesystem::path& file, const JsonValue& at, Builder& b
       if (any_normals)
         for (int k = 0; k < 3; ++k)
           m.normal_indices.push_back(has_normals ? nidx[k] : -1);
+      // uv_indices likewise; a face without vt at every vertex has none (add_mesh's default).
+      if (has_uv && !any_uv) m.uv_indices.assign(3 * m.triangle_count(), -1);
+      any_uv = any_uv || has_uv;
+      if (any_uv)
+        for (int k = 0; k < 3; ++k)
+          m.uv_indices.push_back(has_uv ? tidx[k] : -1);
       int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
       int mat = material_override >= 0 ? material_override : 0;
       float3 em = make_float3(0, 0, 0);

@@ -1,11 +1,13 @@
 // pbrt-v4 scene files (https://pbrt.org/fileformat-v4; "the format page" below): tokenizer,
 // attribute/transform state, Include/Import, object instances (flattened), the perspective camera,
 // film/sampler/integrator settings, triangle/bilinear meshes, PLY meshes (plymesh, read by
-// ply_mesh.cpp), spheres and disks, point/spot/diffuse area lights, and
-// diffuse/conductor/coateddiffuse materials. Everything else is skipped with a one-line warning
-// naming file:line (docs/scene-format.md, "pbrt-v4 scenes"). The result is the same canopy::Scene
-// the JSON loader builds: geometry goes through Builder::add_mesh (transformed in double, rebased
-// to the camera position, rounded once) and lights through the helpers of lights.cpp.
+// ply_mesh.cpp) with their uv, spheres and disks, point/spot/diffuse area lights,
+// diffuse/conductor/coateddiffuse materials, and image textures (imagemap, constant, scale) for
+// their reflectance and roughness. Everything else is skipped with a one-line warning naming
+// file:line (docs/scene-format.md, "pbrt-v4 scenes"; docs/pbrt-scenes.md, "Image textures"). The
+// result is the same canopy::Scene the JSON loader builds: geometry goes through Builder::add_mesh
+// (transformed in double, rebased to the camera position, rounded once) and lights through the
+// helpers of lights.cpp.
 #include "scene/pbrt_reader.h"
 
 #include "scene/loader_internal.h"
@@ -23,6 +25,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <string_view>
 #include <vector>
 
@@ -452,6 +455,17 @@ struct ObjectPart {
   Transform xf; // the shape's CTM at its definition (object -> instance space)
 };
 
+// A named pbrt-v4 texture (the format page, "Textures") as far as Canopy can use it: an image map
+// (with its scale folded in), a constant, or a class Canopy cannot render (warned where it is
+// defined; a material using it keeps the parameter's constant default).
+struct NamedTexture {
+  enum class Kind { Image, Constant, Unsupported };
+  Kind kind = Kind::Unsupported;
+  std::string name;
+  TextureDesc desc;               // Image: all but channels and map, which depend on the use
+  float3 value{1.0f, 1.0f, 1.0f}; // Constant (a float texture: x = y = z)
+};
+
 class Reader {
 public:
   Reader(Scene& s, const std::string& name, const std::filesystem::path& base,
@@ -488,6 +502,17 @@ private:
   void infinite_light(const Token& d, Params& p, const std::filesystem::path& dir);
   void area_light(const Token& d, Params& p, const std::string& type);
   int material(const Loc& loc, Params& p, const std::string& type, const std::string& name);
+  void texture(const Token& d, Params& p, const std::string& name, const std::string& type,
+               const std::string& cls, const std::filesystem::path& dir);
+  NamedTexture image_texture(const Loc& loc, Params& p, const std::string& name,
+                             const std::filesystem::path& dir);
+  // The texture a "texture"-typed parameter names (an error if there is no texture of that type
+  // by that name, as pbrt-v4), or a constant one for a value given in place: "float" (is_float),
+  // else a spectrum (rgb, blackbody or spectrum); nullopt if `name` is not given.
+  std::optional<NamedTexture> texture_param(Params& p, std::string_view name, bool is_float);
+  // The value for Material::albedo_texture / alpha_texture of an image texture used with
+  // `channels` and `map` (one Scene::textures entry per named texture and use).
+  int texture_index(const NamedTexture& t, int channels, int map);
   void add_mesh(const Loc& loc, Mesh& m, const Transform& ctm);
   Transform world(const Transform& ctm) const { return ctm.then(world_fix_); }
 
@@ -505,6 +530,10 @@ private:
   std::vector<Pushed> stack_;
   std::map<std::string, Transform> coord_systems_;
   std::map<std::string, int> named_materials_;
+  // Named textures: global (not scoped by attributes), one namespace per type (pbrt-v4
+  // BasicSceneBuilder::Texture).
+  std::map<std::string, NamedTexture> float_textures_, spectrum_textures_;
+  std::map<std::string, int> texture_indices_; // "<f|s><channels><map>\n<name>" -> texture_index
   std::map<std::string, std::vector<ObjectPart>> objects_;
   std::vector<ObjectPart>* object_ = nullptr; // inside ObjectBegin
   bool world_block_ = false;
@@ -557,8 +586,8 @@ std::optional<float3> Params::spectrum(std::string_view name, Use use, std::stri
     return make_float3(1, 1, 1);
   }
   if (p->type == "texture") {
-    r_.warn(p->loc, fmt::format("{}: textures are not read in this slice (the constant default "
-                                "used), ignored",
+    r_.warn(p->loc, fmt::format("{}: Canopy reads no texture here (the constant default used), "
+                                "ignored",
                                 pn));
     return std::nullopt;
   }
@@ -568,7 +597,7 @@ std::optional<float3> Params::spectrum(std::string_view name, Use use, std::stri
 double Params::get_float(std::string_view name, double def) {
   Param* p = find(name);
   if (p && p->type == "texture") {
-    r_.warn(p->loc, fmt::format("{}: \"texture {}\": textures are not read in this slice (the "
+    r_.warn(p->loc, fmt::format("{}: \"texture {}\": Canopy reads no texture here (the "
                                 "constant default used), ignored",
                                 what_, printable(p->name)));
     return def;
@@ -651,6 +680,7 @@ void reverse_winding(Mesh& m) {
     std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
     if (!m.normal_indices.empty())
       std::swap(m.normal_indices[3 * t + 1], m.normal_indices[3 * t + 2]);
+    if (!m.uv_indices.empty()) std::swap(m.uv_indices[3 * t + 1], m.uv_indices[3 * t + 2]);
   }
 }
 
@@ -669,29 +699,39 @@ void face_forward_to_normals(Mesh& m) {
     if (dot3(ng, ns) < 0.0) {
       std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
       std::swap(m.normal_indices[3 * t + 1], m.normal_indices[3 * t + 2]);
+      if (!m.uv_indices.empty()) std::swap(m.uv_indices[3 * t + 1], m.uv_indices[3 * t + 2]);
     }
   }
 }
 
-// The triangles of a polygon mesh whose vertices (and vertex normals, if any, one per vertex) are
-// in m: `idx` holds 3 indices a triangle, or with `bilinear` 4 a pbrt-v4 BilinearPatch (p00 p10
-// p01 p11, whose normal cross(p10 - p00, p01 - p00) the triangles (p00 p10 p11) and
-// (p00 p11 p01) keep). Then pbrt-v4's orientation: towards the vertex normals, else the winding
-// (reversed by ReverseOrientation).
+// The triangles of a polygon mesh whose vertices (and vertex normals and uv, if any, one per
+// vertex) are in m: `idx` holds 3 indices a triangle, or with `bilinear` 4 a pbrt-v4
+// BilinearPatch (p00 p10 p01 p11, whose normal cross(p10 - p00, p01 - p00) the triangles
+// (p00 p10 p11) and (p00 p11 p01) keep). A bilinear patch without "uv" has pbrt-v4's default, its
+// own parameterisation: (0, 0), (1, 0), (0, 1), (1, 1) at p00, p10, p01, p11 (a triangle's
+// default, (0, 0), (1, 0), (1, 1), is Builder::add_mesh's). Then pbrt-v4's orientation: towards
+// the vertex normals, else the winding (reversed by ReverseOrientation).
 void add_polygons(Mesh& m, const std::vector<uint32_t>& idx, bool bilinear, int32_t material,
                   float3 emission, bool reverse) {
-  auto add = [&](uint32_t x, uint32_t y, uint32_t z) {
+  const bool patch_uv = bilinear && m.uvs.empty();
+  if (patch_uv)
+    m.uvs = {make_float2(0, 0), make_float2(1, 0), make_float2(0, 1), make_float2(1, 1)};
+  auto add = [&](uint32_t x, uint32_t y, uint32_t z, std::initializer_list<int32_t> corner_uv) {
     m.add_triangle(x, y, z, material, emission);
     if (!m.normals.empty())
       m.normal_indices.insert(m.normal_indices.end(), {int32_t(x), int32_t(y), int32_t(z)});
+    if (patch_uv)
+      m.uv_indices.insert(m.uv_indices.end(), corner_uv);
+    else if (!m.uvs.empty())
+      m.uv_indices.insert(m.uv_indices.end(), {int32_t(x), int32_t(y), int32_t(z)});
   };
   if (!bilinear) {
     for (size_t t = 0; t + 2 < idx.size(); t += 3)
-      add(idx[t], idx[t + 1], idx[t + 2]);
+      add(idx[t], idx[t + 1], idx[t + 2], {});
   } else {
     for (size_t t = 0; t + 3 < idx.size(); t += 4) {
-      add(idx[t], idx[t + 1], idx[t + 3]);
-      add(idx[t], idx[t + 3], idx[t + 2]);
+      add(idx[t], idx[t + 1], idx[t + 3], {0, 1, 3});
+      add(idx[t], idx[t + 3], idx[t + 2], {0, 3, 2});
     }
   }
   if (!m.normals.empty())
@@ -700,6 +740,10 @@ void add_polygons(Mesh& m, const std::vector<uint32_t>& idx, bool bilinear, int3
     reverse_winding(m);
 }
 
+// pbrt-v4's Sphere, tessellated, with its uv (in object space): u = phi / (2 pi), phi = atan2(y, x)
+// in [0, 2 pi), and v = (theta - thetaZMin) / (thetaZMax - thetaZMin), which for the full sphere
+// is 1 - theta / pi, theta = acos(z / r). The seam (u = 1 against u = 0) and the poles (one vertex,
+// a u per triangle: the middle of its segment) have uv of their own, apart from the vertices.
 Mesh sphere_mesh(float radius) {
   Mesh m;
   const int nr = kSphereRings, ns = kSphereSegments;
@@ -721,36 +765,57 @@ Mesh sphere_mesh(float radius) {
   m.normals.push_back(make_float3(0, 0, -1));
   const uint32_t south = uint32_t(m.vertices.size() - 1);
   auto ring = [&](int i, int j) { return uint32_t(1 + (i - 1) * ns + ((j % ns) + ns) % ns); };
-  auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
+  // uv: the rings' grid (ns + 1 columns: column ns is the seam at u = 1), then the poles' ns each.
+  for (int i = 1; i < nr; ++i)
+    for (int j = 0; j <= ns; ++j)
+      m.uvs.push_back(make_float2(float(double(j) / ns), float(1.0 - double(i) / nr)));
+  const int32_t north_uv = int32_t(m.uvs.size()), south_uv = north_uv + ns;
+  for (float v : {1.0f, 0.0f})
+    for (int j = 0; j < ns; ++j)
+      m.uvs.push_back(make_float2(float((j + 0.5) / ns), v));
+  auto grid = [&](int i, int j) { return int32_t((i - 1) * (ns + 1) + j); };
+  auto tri = [&](uint32_t a, uint32_t b, uint32_t c, int32_t ua, int32_t ub, int32_t uc) {
     m.add_triangle(a, b, c, 0, make_float3(0, 0, 0));
     m.normal_indices.insert(m.normal_indices.end(), {int32_t(a), int32_t(b), int32_t(c)});
+    m.uv_indices.insert(m.uv_indices.end(), {ua, ub, uc});
   };
   // Counter-clockwise seen from outside: the winding normal points out, as pbrt's sphere normal.
   for (int j = 0; j < ns; ++j)
-    tri(0, ring(1, j), ring(1, j + 1));
+    tri(0, ring(1, j), ring(1, j + 1), north_uv + j, grid(1, j), grid(1, j + 1));
   for (int i = 1; i < nr - 1; ++i)
     for (int j = 0; j < ns; ++j) {
-      tri(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1));
-      tri(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1));
+      tri(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1), grid(i, j), grid(i + 1, j),
+          grid(i + 1, j + 1));
+      tri(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1), grid(i, j), grid(i + 1, j + 1),
+          grid(i, j + 1));
     }
   for (int j = 0; j < ns; ++j)
-    tri(ring(nr - 1, j), south, ring(nr - 1, j + 1));
+    tri(ring(nr - 1, j), south, ring(nr - 1, j + 1), grid(nr - 1, j), south_uv + j,
+        grid(nr - 1, j + 1));
   return m;
 }
 
-// pbrt's disk: radius r at z = height, normal +z (pbrt-v4 Disk).
+// pbrt's disk: radius r at z = height, normal +z (pbrt-v4 Disk), with its uv: u = phi / (2 pi),
+// v = (radius - r) / (radius - innerradius) (innerradius 0 here: 1 at the centre, 0 on the rim).
+// The seam and the centre have uv of their own, as the sphere's.
 Mesh disk_mesh(float radius, float height) {
   Mesh m;
+  const int ns = kDiskSegments;
   const double pi = 3.14159265358979323846;
   m.vertices.push_back(make_float3(0, 0, height));
-  for (int j = 0; j < kDiskSegments; ++j) {
-    double ph = 2.0 * pi * j / kDiskSegments;
+  for (int j = 0; j < ns; ++j) {
+    double ph = 2.0 * pi * j / ns;
     m.vertices.push_back(
         make_float3(float(radius * std::cos(ph)), float(radius * std::sin(ph)), height));
   }
-  for (int j = 0; j < kDiskSegments; ++j)
-    m.add_triangle(0, uint32_t(1 + j), uint32_t(1 + (j + 1) % kDiskSegments), 0,
-                   make_float3(0, 0, 0));
+  for (int j = 0; j <= ns; ++j) // the rim, column ns the seam at u = 1
+    m.uvs.push_back(make_float2(float(double(j) / ns), 0.0f));
+  for (int j = 0; j < ns; ++j) // the centre, per triangle
+    m.uvs.push_back(make_float2(float((j + 0.5) / ns), 1.0f));
+  for (int j = 0; j < ns; ++j) {
+    m.add_triangle(0, uint32_t(1 + j), uint32_t(1 + (j + 1) % ns), 0, make_float3(0, 0, 0));
+    m.uv_indices.insert(m.uv_indices.end(), {ns + 1 + j, j, j + 1});
+  }
   return m;
 }
 
@@ -988,7 +1053,16 @@ void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& d
       skip();
       return;
     }
-    if (k == "Texture" || k == "MakeNamedMedium" || k == "MediumInterface" || k == "Attribute" ||
+    if (k == "Texture") {
+      need_world(true);
+      std::string name = one_string(d, lx);
+      std::string type = one_string(d, lx);
+      std::string cls = one_string(d, lx);
+      Params p(*this, parse_params(lx), fmt::format("Texture \"{}\"", printable(name, 40)));
+      texture(d, p, name, type, cls, dir);
+      return;
+    }
+    if (k == "MakeNamedMedium" || k == "MediumInterface" || k == "Attribute" ||
         k == "ActiveTransform" || k == "TransformTimes" || k == "PixelFilter" ||
         k == "Accelerator" || k == "ColorSpace") {
       warn(d.loc, fmt::format("{} is not read in this slice, ignored", k));
@@ -1269,13 +1343,29 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
     for (size_t i = 0; i < v->size(); i += 3)
       m.normals.push_back(to_float3({(*v)[i], (*v)[i + 1], (*v)[i + 2]}));
   };
+  // Texture coordinates, one pair per vertex ("float uv" is pbrt-v3's spelling).
+  auto uvs = [&](size_t nverts) {
+    const auto* v = p.get_nums("uv", {"point2", "float"});
+    if (!v) return;
+    const Param& q = *p.find("uv");
+    if (v->size() != 2 * nverts)
+      fail(q.loc, fmt::format("{}: \"{} uv\": wrong count of values ({}; want {}, one pair per "
+                              "vertex)",
+                              p.what(), q.type, v->size(), 2 * nverts));
+    for (size_t i = 0; i < v->size(); i += 2) {
+      float2 uv = make_float2(to_float((*v)[i]), to_float((*v)[i + 1]));
+      if (!std::isfinite(uv.x + uv.y))
+        fail(q.loc, fmt::format("{}: \"{} uv\": a value is too large", p.what(), q.type));
+      m.uvs.push_back(uv);
+    }
+  };
 
   if (type == "trianglemesh" || type == "bilinearmesh") {
     const bool tri = type == "trianglemesh";
     m.vertices = points("P", tri ? 3 : 4);
     std::vector<uint32_t> idx = indices(tri ? 3 : 4, m.vertices.size());
     normals(m.vertices.size());
-    p.find("uv"); // texture coordinates: parsed (checked) but unused until textures are read
+    uvs(m.vertices.size());
     add_polygons(m, idx, !tri, gs_.material, emission(), gs_.reverse);
   } else if (type == "plymesh") {
     // pbrt-v4 makes bilinear patches of a PLY file's quads; triangles are the same surface for
@@ -1294,6 +1384,7 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
            fmt::format("{}: no faces of 3 or more vertices, nothing added, ignored", p.what()));
     m.vertices = std::move(ply.positions);
     m.normals = std::move(ply.normals);
+    m.uvs = std::move(ply.uv);
     add_polygons(m, ply.indices, false, gs_.material, emission(), gs_.reverse);
     // Only used to tessellate for displacement, which is ignored below.
     if (Param* q = p.one("edgelength", {"float"}))
@@ -1546,25 +1637,255 @@ void Reader::area_light(const Token& d, Params& p, const std::string& type) {
   gs_.area_twosided = two;
 }
 
+// The format page, "Textures": `Texture "name" "float"|"spectrum" "class" params`. Canopy renders
+// "imagemap" (pbrt-v4 FloatImageTexture / SpectrumImageTexture), "constant", and "scale" when it
+// multiplies one of those by a constant (folded into the image's scale, as pbrt-v4's
+// FloatScaledTexture::Create does). Other classes warn here; a material using one keeps the
+// parameter's constant default.
+void Reader::texture(const Token& d, Params& p, const std::string& name, const std::string& type,
+                     const std::string& cls, const std::filesystem::path& dir) {
+  const Loc& loc = d.loc;
+  if (type != "float" && type != "spectrum")
+    fail(loc, fmt::format("{}: texture type \"{}\" unknown (want \"float\" or \"spectrum\")",
+                          p.what(), printable(type)));
+  const bool is_float = type == "float";
+  auto& named = is_float ? float_textures_ : spectrum_textures_;
+  // pbrt-v4 refuses a second definition of a name (of the same type) too.
+  if (named.count(name))
+    fail(loc, fmt::format("{}: the {} texture \"{}\" is defined twice", p.what(), type,
+                          printable(name)));
+  NamedTexture t;
+  if (cls == "imagemap") {
+    t = image_texture(loc, p, name, dir);
+  } else if (cls == "constant") {
+    t.kind = NamedTexture::Kind::Constant;
+    if (is_float) {
+      float v = to_float(p.get_float("value", 1.0));
+      t.value = make_float3(v, v, v);
+    } else {
+      t.value = p.spectrum("value", Params::Use::Reflectance).value_or(make_float3(1, 1, 1));
+    }
+  } else if (cls == "scale") {
+    // pbrt-v4 FloatScaledTexture / SpectrumScaledTexture: tex * scale, both textures (default 1).
+    std::optional<NamedTexture> tex = texture_param(p, "tex", is_float),
+                                sc = texture_param(p, "scale", true);
+    NamedTexture one;
+    one.kind = NamedTexture::Kind::Constant;
+    NamedTexture a = tex.value_or(one), b = sc.value_or(one);
+    using K = NamedTexture::Kind;
+    if (a.kind == K::Constant && b.kind == K::Image && is_float) std::swap(a, b);
+    if (a.kind == K::Unsupported || b.kind == K::Unsupported) {
+      t.kind = K::Unsupported; // warned where it was defined
+    } else if (b.kind == K::Image) {
+      warn(loc, fmt::format("{}: \"scale\" of {}: Canopy multiplies an image only by a constant "
+                            "(the material's constant default used), ignored",
+                            p.what(), a.kind == K::Image ? "two images" : "an image scale"));
+      t.kind = K::Unsupported;
+    } else if (a.kind == K::Image) {
+      t = a;
+      t.desc.scale = t.desc.scale * b.value.x;
+      t.desc.where = fmt::format("{}:{}: texture \"{}\"", *loc.file, loc.line, name);
+    } else {
+      t.kind = K::Constant;
+      t.value = a.value * b.value.x;
+    }
+  } else {
+    static const std::set<std::string> known = {"bilerp", "checkerboard", "directionmix", "dots",
+                                                "fbm",    "marble",       "mix",          "ptex",
+                                                "windy",  "wrinkled"};
+    warn(loc, fmt::format("{}: {} texture class \"{}\" is not supported (a material using it "
+                          "keeps its constant default), ignored",
+                          p.what(), known.count(cls) ? "the" : "unknown", printable(cls)));
+    p.mark_all_used();
+  }
+  p.finish();
+  t.name = name;
+  named[name] = std::move(t);
+}
+
+NamedTexture Reader::image_texture(const Loc& loc, Params& p, const std::string& name,
+                                   const std::filesystem::path& dir) {
+  NamedTexture t;
+  t.kind = NamedTexture::Kind::Image;
+  TextureDesc& td = t.desc;
+  td.where = fmt::format("{}:{}: texture \"{}\"", *loc.file, loc.line, printable(name));
+  const std::optional<std::string> f = p.get_string("filename");
+  if (!f) fail(loc, fmt::format("{}: needs \"string filename\"", p.what()));
+  std::filesystem::path file(*f);
+  if (file.is_relative()) file = dir / file; // as Include
+  std::error_code ec;
+  if (f->empty() || !std::filesystem::is_regular_file(file, ec))
+    fail(p.find("filename")->loc, fmt::format("{}: \"string filename\" {}: no such file", p.what(),
+                                              printable(file.string(), 1024)));
+  td.file = file;
+  if (auto w = p.get_string("wrap")) {
+    if (*w == "repeat")
+      td.wrap = TEXTURE_WRAP_REPEAT;
+    else if (*w == "clamp")
+      td.wrap = TEXTURE_WRAP_CLAMP;
+    else if (*w == "black")
+      td.wrap = TEXTURE_WRAP_BLACK;
+    else
+      fail(p.find("wrap")->loc,
+           fmt::format("{}: \"string wrap\" \"{}\": unknown wrap mode (want \"repeat\", \"clamp\" "
+                       "or \"black\")",
+                       p.what(), printable(*w)));
+  }
+  // pbrt-v4 reads a PNG with the given encoding (default sRGB); other 8-bit images are sRGB and
+  // float images linear whatever it says (Image::Read): ImageEncoding::Auto, so the parameter
+  // counts for a PNG only, here too.
+  if (auto e = p.get_string("encoding")) {
+    const Loc& el = p.find("encoding")->loc;
+    ImageEncoding enc = ImageEncoding::Auto;
+    float gamma = 1.0f;
+    if (*e == "sRGB") {
+      enc = ImageEncoding::Srgb;
+    } else if (*e == "linear") {
+      enc = ImageEncoding::Linear;
+    } else {
+      std::istringstream in(*e);
+      std::string word, extra;
+      double g = 0.0;
+      if (!(in >> word >> g) || word != "gamma" || (in >> extra) || !(g > 0.0) ||
+          !std::isfinite(float(g)))
+        fail(el, fmt::format("{}: \"string encoding\" \"{}\": unknown encoding (want \"sRGB\", "
+                             "\"linear\" or \"gamma <value>\" with a value > 0)",
+                             p.what(), printable(*e)));
+      enc = ImageEncoding::Gamma;
+      gamma = float(g);
+    }
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".png") {
+      td.encoding = enc;
+      td.gamma = gamma;
+    }
+  }
+  double scale = p.get_float("scale", 1.0);
+  if (!(scale >= 0.0) || !std::isfinite(float(scale)))
+    fail(p.find("scale")->loc,
+         fmt::format("{}: \"float scale\": must be >= 0 and a finite float", p.what()));
+  td.scale = make_float3(float(scale), float(scale), float(scale));
+  if (p.get_bool("invert", false))
+    warn(p.find("invert")->loc,
+         fmt::format("{}: \"bool invert\" true (1 - value) is not supported, ignored", p.what()));
+  // pbrt-v4's filters: point, bilinear (its default), trilinear, EWA; maxanisotropy only matters
+  // to EWA, so with bilinear filtering it changes nothing in pbrt either.
+  std::string filter = p.get_string("filter").value_or("bilinear");
+  double aniso = p.get_float("maxanisotropy", 8.0);
+  if (filter != "bilinear")
+    warn(p.find("filter")->loc,
+         fmt::format("{}: \"string filter\" \"{}\"{}: Canopy filters bilinearly, ignored", p.what(),
+                     printable(filter),
+                     p.find("maxanisotropy") ? fmt::format(" (maxanisotropy {})", aniso) : ""));
+  std::string mapping = p.get_string("mapping").value_or("uv");
+  if (mapping != "uv") {
+    warn(p.find("mapping")->loc,
+         fmt::format("{}: \"string mapping\" \"{}\": only \"uv\" mapping is supported (uv used), "
+                     "ignored",
+                     p.what(), printable(mapping)));
+    for (const char* planar : {"v1", "v2"}) // the planar mapping's vectors
+      p.find(planar);
+  }
+  double uvm[4] = {p.get_float("uscale", 1.0), p.get_float("vscale", 1.0),
+                   p.get_float("udelta", 0.0), p.get_float("vdelta", 0.0)};
+  for (double x : uvm)
+    if (!std::isfinite(float(x)))
+      fail(loc, fmt::format("{}: uscale, vscale, udelta, vdelta: a value is too large", p.what()));
+  td.uvmap = make_float4(float(uvm[0]), float(uvm[1]), float(uvm[2]), float(uvm[3]));
+  return t;
+}
+
+std::optional<NamedTexture> Reader::texture_param(Params& p, std::string_view name, bool is_float) {
+  Param* q = p.find(name);
+  if (!q) return std::nullopt;
+  if (q->type == "texture") {
+    if (q->strs.size() != 1)
+      fail(q->loc, fmt::format("{}: \"texture {}\": wrong count of values ({}; want 1)", p.what(),
+                               printable(q->name), q->strs.size()));
+    const auto& named = is_float ? float_textures_ : spectrum_textures_;
+    auto it = named.find(q->strs[0]);
+    if (it == named.end()) {
+      const auto& other = is_float ? spectrum_textures_ : float_textures_;
+      fail(q->loc,
+           fmt::format("{}: \"texture {}\": no {} texture named \"{}\"{}", p.what(),
+                       printable(q->name), is_float ? "float" : "spectrum", printable(q->strs[0]),
+                       other.count(q->strs[0])
+                           ? fmt::format(" (\"{}\" is a {} texture)", printable(q->strs[0]),
+                                         is_float ? "spectrum" : "float")
+                           : ""));
+    }
+    return it->second;
+  }
+  NamedTexture t;
+  t.kind = NamedTexture::Kind::Constant;
+  if (is_float) {
+    float v = to_float(p.get_float(name, 1.0));
+    t.value = make_float3(v, v, v);
+  } else {
+    t.value = p.spectrum(name, Params::Use::Reflectance).value_or(make_float3(1, 1, 1));
+  }
+  return t;
+}
+
+int Reader::texture_index(const NamedTexture& t, int channels, int map) {
+  std::string key = fmt::format("{}{}{}\n{}", channels == 1 ? 'f' : 's', channels, map, t.name);
+  if (auto it = texture_indices_.find(key); it != texture_indices_.end()) return it->second;
+  TextureDesc td = t.desc;
+  td.channels = channels;
+  td.map = map;
+  int id = add_texture(scene_, std::move(td));
+  texture_indices_.emplace(key, id);
+  return id;
+}
+
 // The format page, "Materials". Returns the index of the new scene material.
 int Reader::material(const Loc& loc, Params& p, const std::string& type, const std::string& name) {
   // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha is alpha = sqrt(roughness), applied
   // when remaproughness is true (the default); Canopy's roughness r means alpha = r^2
   // (scene.h conductor_material). So Canopy's r is roughness^(1/4) when remapped and
   // sqrt(roughness) otherwise. Alpha above 1 is beyond Canopy's range and is clamped.
+  // A roughness image texture sets *alpha_texture instead (map TEXTURE_MAP_ALPHA_SQRT, or
+  // TEXTURE_MAP_VALUE without remapping); the returned constant is then unused.
+  using K = NamedTexture::Kind;
+  int albedo_texture = 0, alpha_texture = 0;
   auto roughness = [&]() -> float {
-    double r = p.get_float("roughness", 0.0);
-    Param* ur = p.find("uroughness");
-    Param* vr = p.find("vroughness");
-    double u = ur ? p.get_float("uroughness", r) : r, v = vr ? p.get_float("vroughness", r) : r;
-    if (u != v)
-      warn(ur ? ur->loc : vr->loc,
+    // pbrt-v4: uroughness and vroughness, each defaulting to roughness (itself 0).
+    struct Rough {
+      double value = 0.0;
+      const NamedTexture* image = nullptr; // in float_textures_ (stable)
+      const Param* param = nullptr;
+    };
+    auto get = [&](const char* key) -> std::optional<Rough> {
+      Param* q = p.find(key);
+      if (!q) return std::nullopt;
+      if (q->type != "texture") return Rough{p.get_float(key, 0.0), nullptr, q};
+      std::optional<NamedTexture> t = texture_param(p, key, true);
+      if (t->kind == K::Image) return Rough{0.0, &float_textures_.at(q->strs[0]), q};
+      return Rough{t->kind == K::Constant ? double(t->value.x) : 0.0, nullptr, q};
+    };
+    Rough r = get("roughness").value_or(Rough{});
+    Rough u = get("uroughness").value_or(r), v = get("vroughness").value_or(r);
+    bool remap = p.get_bool("remaproughness", true);
+    if (u.image || v.image) {
+      const Rough& used = u.image ? u : v;
+      if (u.image != v.image || u.value != v.value)
+        warn(used.param->loc,
+             fmt::format("{}: uroughness and vroughness differ: Canopy's GGX is isotropic, the "
+                         "texture \"{}\" used, anisotropy ignored",
+                         p.what(), printable(used.image->name)));
+      alpha_texture =
+          texture_index(*used.image, 1, remap ? TEXTURE_MAP_ALPHA_SQRT : TEXTURE_MAP_VALUE);
+      return 0.0f;
+    }
+    if (u.value != v.value)
+      warn(u.param ? u.param->loc : v.param->loc,
            fmt::format("{}: uroughness {} != vroughness {}: Canopy's GGX is isotropic, their mean "
                        "used, anisotropy ignored",
-                       p.what(), u, v));
-    double rr = 0.5 * (u + v);
+                       p.what(), u.value, v.value));
+    double rr = 0.5 * (u.value + v.value);
     if (!(rr >= 0.0)) fail(loc, fmt::format("{}: roughness must be >= 0", p.what()));
-    bool remap = p.get_bool("remaproughness", true);
     double alpha = remap ? std::sqrt(rr) : rr;
     if (alpha > 1.0) {
       warn(loc,
@@ -1573,10 +1894,19 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
     }
     return float(std::sqrt(alpha));
   };
-  auto albedo = [&](const char* key) {
-    float3 c = p.spectrum(key, Params::Use::Reflectance).value_or(make_float3(0.5f, 0.5f, 0.5f));
+  auto clamp01 = [](float3 c) {
     // pbrt-v4 clamps reflectances to [0, 1] (DiffuseMaterial, CoatedDiffuseMaterial).
     return make_float3(std::min(c.x, 1.0f), std::min(c.y, 1.0f), std::min(c.z, 1.0f));
+  };
+  auto albedo = [&](const char* key) {
+    const float3 def = make_float3(0.5f, 0.5f, 0.5f);
+    if (Param* q = p.find(key); q && q->type == "texture") {
+      std::optional<NamedTexture> t = texture_param(p, key, false);
+      if (t->kind == K::Image)
+        albedo_texture = texture_index(spectrum_textures_.at(q->strs[0]), 3, TEXTURE_MAP_VALUE);
+      return t->kind == K::Constant ? clamp01(t->value) : def;
+    }
+    return clamp01(p.spectrum(key, Params::Use::Reflectance).value_or(def));
   };
   std::string mname = name.empty() ? fmt::format("pbrt:{}:{}", *loc.file, loc.line) : name;
   for (const char* skip : {"displacement", "normalmap"})
@@ -1588,10 +1918,24 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
   } else if (type == "conductor") {
     float r = roughness();
     float3 eta, k;
-    if (p.find("reflectance")) {
+    // A textured "reflectance": only a constant texture is read (an image warns, and the
+    // default conductor, eta and k, is used).
+    std::optional<float3> refl;
+    if (Param* q = p.find("reflectance"); q && q->type == "texture") {
+      std::optional<NamedTexture> t = texture_param(p, "reflectance", false);
+      if (t->kind == K::Constant)
+        refl = clamp01(t->value);
+      else if (t->kind == K::Image)
+        warn(q->loc, fmt::format("{}: \"texture reflectance\" \"{}\": Canopy's conductor takes no "
+                                 "reflectance image (eta and k used), ignored",
+                                 p.what(), printable(q->strs[0])));
+    } else if (q) {
+      refl = albedo("reflectance");
+    }
+    if (refl) {
       // pbrt-v4 ConductorMaterial with "reflectance": eta = 1, k = 2 sqrt(r) / sqrt(1 - r),
       // the index whose normal-incidence Fresnel reflectance is r.
-      float3 c = albedo("reflectance");
+      float3 c = *refl;
       auto kk = [](float x) {
         x = std::clamp(x, 0.0f, 0.9999f);
         return 2.0f * std::sqrt(x) / std::sqrt(1.0f - x);
@@ -1678,6 +2022,8 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
   }
   p.find("type"); // MakeNamedMaterial's type is read by the caller
   p.finish();
+  md.gpu.albedo_texture = albedo_texture;
+  md.gpu.alpha_texture = alpha_texture;
   scene_.materials.push_back(md);
   return int(scene_.materials.size()) - 1;
 }

@@ -240,7 +240,8 @@ uint64_t vertex_count(const Header& h) {
 }
 
 // Face indices are checked before Assimp sees them: its triangulation reads the vertices of a
-// polygon by index, so one out of range crashes it.
+// polygon by index, so one out of range crashes it, and it aborts on a face without vertices
+// (an assertion in TriangulateProcess; the checks refuse such a face).
 void check_index(double v, const Element& e, uint64_t i, uint64_t vertices,
                  const std::string& prefix) {
   if (!(v >= 0.0 && v < double(vertices)))
@@ -306,6 +307,8 @@ void check_binary(const std::string& d, const Header& h, const std::string& pref
             fail(prefix, fmt::format("{}: list \"{}\" has {} entries", where(e, i),
                                      printable(p.name, 40), c));
           n = uint64_t(c);
+          if (n == 0 && face_indices(e, p))
+            fail(prefix, fmt::format("{}: a face without vertices", where(e, i)));
         }
         if (n > (d.size() - pos) / uint64_t(p.item.size)) truncated(e, i);
         if (face_indices(e, p))
@@ -362,6 +365,7 @@ void check_ascii(const std::string& d, const Header& h, const std::string& prefi
             bad(fmt::format("list \"{}\" has the length '{}'", printable(p.name, 40),
                             printable(t[k - 1], 40)));
           n = uint64_t(c);
+          if (n == 0 && face_indices(e, p)) bad("a face without vertices");
         }
         if (n > t.size() - k) bad("too few values");
         for (uint64_t j = 0; j < n; ++j, ++k) {

@@ -18,8 +18,8 @@ struct PlyMesh {
   std::vector<float3> positions;
   std::vector<uint32_t> indices; // 3 per triangle, into positions
   std::vector<float3> normals;   // per vertex (nx ny nz), as stored; empty if the file has none
-  // Per vertex (u v, s t or texture_u texture_v), as stored; empty if the file has none. No
-  // consumer yet: image textures will read it.
+  // Per vertex (u v, s t, texture_u texture_v or texture_s texture_t), as stored; empty if the
+  // file has none. The plymesh's uv (pbrt_reader.cpp).
   std::vector<float2> uv;
   size_t skipped_faces = 0; // faces of fewer than 3 vertices (points, lines)
 };
