@@ -112,12 +112,19 @@ canopy_cli_test(cli_spp_above_a_million
 canopy_cli_test(cli_spp_above_format_limit -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
   "-DARGS=--spp|16777217" "-DEXPECT=--spp: must be in [1, 16777216], got 16777217"
   -P ${CANOPY_CHECK2})
-# Issues 10 and 20: a scene without sampler settings renders with the measured default (brdf-mis,
-# its tree-split part at the measured default threshold) and pbrt-v4's default depth, and the
-# summary line says so; --max-cut and --max-depth override the scene and are range-checked.
-canopy_cli_test(cli_default_sampler_summary
+# Issues 10 and 20: a scene without sampler settings renders with the measured default (auto: a
+# pilot picks the sampler, and says which) and pbrt-v4's default depth, and the summary line says
+# so; a partial render takes brdf-mis without a pilot (its parts must merge exactly); --max-cut
+# and --max-depth override the scene and are range-checked.
+canopy_cli_test(cli_default_sampler_auto
   "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--out|${CANOPY_SCRATCH}/defaults.exr"
-  "-DSTDERR=1 spp, sampler brdf-mis (threshold 0.25, max cut 64, delta 0.5, N_max 50, lambda 10), max depth 5, 1 lights"
+  "-DSTDERR=canopy: auto: " -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_default_sampler_summary
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--out|${CANOPY_SCRATCH}/defaults2.exr"
+  "-DSTDERR=max depth 5, 1 lights" -P ${CANOPY_CHECK_CLI})
+canopy_cli_test(cli_default_sampler_partial
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--samples|0:1|--out|${CANOPY_SCRATCH}/defaults3.exr"
+  "-DSTDERR=1 spp (samples 0:1), sampler brdf-mis (threshold 0.25, max cut 64, delta 0.5, N_max 50, lambda 10), max depth 5, 1 lights"
   -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_max_cut_option
   "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--light-sampler|tree-split|--max-cut|3|--max-depth|2|--out|${CANOPY_SCRATCH}/max_cut.exr"

@@ -86,3 +86,28 @@ TEST(AutoSampler, ABlackScenePicksTheFastest) {
   }
   EXPECT_EQ(choice.chosen.seconds, fastest);
 }
+
+// One dim light close over the floor outshines 65,536 distant ones there, but holds 6e-9 of the
+// power: power sampling picks it about never in a pilot of at most ~10^5 samples, so its image
+// mean falls far below the others' and its measured variance means nothing. It is not ranked.
+TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRanked) {
+  const char* json = R"({
+    "camera": { "position": [0, 3, 3], "look_at": [0, 0, 0], "fov": 50 },
+    "film": { "width": 64, "height": 48 },
+    "integrator": { "max_depth": 1 },
+    "shapes": [ { "type": "quad", "corner": [-2, 0, 2], "edge1": [4, 0, 0], "edge2": [0, 0, -4] } ],
+    "lights": [ { "type": "point", "position": [0, 0.5, 0], "intensity": 0.04 } ],
+    "light_sets": [ { "type": "grid", "origin": [-10000, 10000, -10000], "edge1": [20000, 0, 0],
+                      "edge2": [0, 0, 20000], "nx": 256, "ny": 256,
+                      "light": { "type": "point", "intensity": 100 } } ]
+  })";
+  Scene scene = load_scene_from_string(json, "tail.json", ".");
+  ClRuntime rt;
+  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
+  Renderer renderer(rt, scene, base);
+  AutoChoice choice = choose_light_sampler(renderer, base, 11);
+  EXPECT_TRUE(choice.candidates[0].missed_tail) << describe(choice);
+  EXPECT_FALSE(choice.candidates[1].missed_tail) << describe(choice);
+  EXPECT_NE(choice.chosen.label, "power");
+  EXPECT_NE(describe(choice).find("missed its tail"), std::string::npos);
+}

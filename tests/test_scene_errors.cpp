@@ -227,7 +227,7 @@ TEST(SceneErrors, BrdfParametersOutOfRange) {
 TEST(SceneErrors, UnknownLightSampler) {
   EXPECT_EQ(error_of(scene_with(R"("integrator": {"light_sampler": "best"})")),
             "scene.json: integrator.light_sampler: unknown value \"best\" (expected one of: "
-            "uniform, power, tree, tree-split, exhaustive, bsdf, brdf-mis, brdf-oriented)");
+            "auto, uniform, power, tree, tree-split, exhaustive, bsdf, brdf-mis, brdf-oriented)");
 }
 
 TEST(SceneErrors, SplitThresholdAboveOne) {
@@ -856,9 +856,9 @@ TEST(SceneErrors, LongKeyIsTruncated) {
 
 TEST(SceneErrors, EnumValueIsEscaped) {
   std::string m = error_of(scene_with(R"("integrator": {"light_sampler": "tree\r\nsplit"})"));
-  EXPECT_EQ(m,
-            "scene.json: integrator.light_sampler: unknown value \"tree\\r\\nsplit\" (expected "
-            "one of: uniform, power, tree, tree-split, exhaustive, bsdf, brdf-mis, brdf-oriented)");
+  EXPECT_EQ(m, "scene.json: integrator.light_sampler: unknown value \"tree\\r\\nsplit\" (expected "
+               "one of: auto, uniform, power, tree, tree-split, exhaustive, bsdf, brdf-mis, "
+               "brdf-oriented)");
 }
 
 TEST(SceneErrors, MaterialNameIsEscaped) {

@@ -3,6 +3,8 @@
 #include "scene/pbrt_reader.h"
 #include "scene/scene.h"
 
+#include "support/pbrt_text.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,20 +16,14 @@ using namespace canopy;
 
 namespace {
 
-const std::filesystem::path kData = std::filesystem::path(CANOPY_TEST_DATA_DIR) / "pbrt";
+const std::filesystem::path& kData = test::kPbrtData;
 
 Scene load(const std::string& text, bool strict = false) {
-  return load_pbrt_scene_from_string(text, "t.pbrt", kData, SceneLoadOptions{strict});
+  return test::load_pbrt(text, strict);
 }
 
-// The SceneError message of loading `text` ("" if it loads).
 std::string error_of(const std::string& text, bool strict = false) {
-  try {
-    load(text, strict);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
+  return test::pbrt_error_of(text, strict);
 }
 
 std::string error_of_file(const std::filesystem::path& f) {

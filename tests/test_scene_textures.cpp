@@ -6,6 +6,8 @@
 #include "scene/pbrt_reader.h"
 #include "scene/scene.h"
 
+#include "support/pbrt_text.h"
+
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -20,21 +22,16 @@ using namespace canopy;
 
 namespace {
 
-const std::filesystem::path kData = std::filesystem::path(CANOPY_TEST_DATA_DIR) / "pbrt";
+const std::filesystem::path& kData = test::kPbrtData;
 const std::filesystem::path kChecker = kData / "textures" / "checker.png";
 const std::filesystem::path kRough = kData / "textures" / "rough.png";
 
 Scene load(const std::string& text, bool strict = false) {
-  return load_pbrt_scene_from_string(text, "t.pbrt", kData, SceneLoadOptions{strict});
+  return test::load_pbrt(text, strict);
 }
 
 std::string error_of(const std::string& text, bool strict = false) {
-  try {
-    load(text, strict);
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "(no error)";
+  return test::pbrt_error_of(text, strict);
 }
 
 // The frames agree with Canopy's (Scale -1 1 1), so the world is kept as written. Three lines: the
@@ -52,9 +49,9 @@ const std::string kWood =
 const std::string kRoughTex =
     "Texture \"r\" \"float\" \"imagemap\" \"string filename\" \"textures/rough.png\"\n";
 
-// Builder::add_mesh (scene_loader.cpp) keeps no uv for the scene's first mesh when it is the first
-// with uv (triangle_uvs stays empty: DISABLED_FirstMeshOfTheSceneKeepsItsUv below). Until that is
-// fixed the uv tests put a triangle without uv first: triangle kLead is the first one tested.
+// The uv tests put a triangle without uv first, so each also checks that a mesh with uv after one
+// without gets its own (and the earlier one the default): triangle kLead is the first one tested.
+// FirstMeshOfTheSceneKeepsItsUv covers a first mesh with uv.
 const std::string kLeadTri =
     "Shape \"trianglemesh\" \"point3 P\" [0 0 -1  1 0 -1  0 1 -1] \"integer indices\" [0 1 2]\n";
 constexpr size_t kLead = 1;
@@ -708,9 +705,9 @@ TEST(SceneTexturesObj, MissingMapKdFileIsAnErrorNamingTheMtlAndTheMap) {
                    (d.dir / "nothing.png").string() + "': no such file");
 }
 
-// Builder::add_mesh keeps no uv when the scene's first mesh is the first with uv (reported to the
-// lead; scene_loader.cpp is not the loaders' file). Enable once that is fixed, and drop kLeadTri.
-TEST(SceneTexturesPbrt, DISABLED_FirstMeshOfTheSceneKeepsItsUv) {
+// The scene's first mesh with uv keeps them (Builder::add_mesh once kept none when no triangle
+// came before it).
+TEST(SceneTexturesPbrt, FirstMeshOfTheSceneKeepsItsUv) {
   Scene s = load(kHead + "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer "
                          "indices\" [0 1 2] \"point2 uv\" [0.1 0.2  0.3 0.4  0.5 0.6]\n");
   expect_uv(s, 0, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});

@@ -355,8 +355,22 @@ int run_render(const RenderArgs& args) {
   ropt.brdf.adaptive = scene.integrator.brdf_adaptive;
   // "auto": the renderer starts with the first candidate; the pilot leaves it at the winner, which
   // the summary, the metadata and the stats then name.
-  const bool automatic = scene.integrator.light_sampler == kAutoLightSampler;
-  if (automatic) ropt = auto_candidates(ropt).front().options;
+  // A partial render (--samples, --crop) takes the last candidate without a pilot: the pilot's
+  // outcome depends on timings, and the parts of one image must use one sampler to merge into
+  // exactly the single render.
+  bool automatic = scene.integrator.light_sampler == kAutoLightSampler;
+  if (automatic && (args.samples || args.crop)) {
+    automatic = false;
+    ropt = auto_candidates(ropt).back().options;
+    scene.integrator.light_sampler = ropt.light_sampler;
+    scene.integrator.split_threshold = ropt.split_threshold;
+  }
+  if (automatic) {
+    // A film that cannot fit fails now, not after the pilot.
+    check_film_memory(rt.device(), uint64_t(scene.film.width) * uint64_t(scene.film.height),
+                      scene.path.string());
+    ropt = auto_candidates(ropt).front().options;
+  }
   Renderer renderer(rt, scene, ropt);
   std::optional<AutoChoice> choice;
   if (automatic) {

@@ -1,5 +1,7 @@
 #include "render/memory_budget.h"
 
+#include "render/renderer.h"
+
 #include <fmt/format.h>
 
 #include <unistd.h>
@@ -86,6 +88,16 @@ void check_scene_memory(const cl::Device& device, const Scene& scene) {
       {"prims", (tris + area_lights) * sizeof(Primitive)},
   };
   check_memory(device, dev, host, printable(scene.path.string(), 1024));
+}
+
+void check_film_memory(const cl::Device& device, uint64_t pixels, const std::string& what) {
+  check_memory(
+      device,
+      {{"film_sum", pixels * sizeof(double4)},
+       {"film_sumsq", pixels * sizeof(double4)},
+       {"film_counts", pixels * sizeof(double4)}},
+      {{"film (host copy)", pixels * 3 * sizeof(double4)}, {"image", pixels * 3 * sizeof(float)}},
+      printable(what, 1024));
 }
 
 } // namespace canopy

@@ -46,4 +46,9 @@ void check_memory(const cl::Device& device, const std::vector<MemoryNeed>& devic
 // and the per-light sampler tables, triangles), checked before any of them is built.
 void check_scene_memory(const cl::Device& device, const Scene& scene);
 
+// The film of a render of `pixels` pixels (its three double4 accumulators on the device, their
+// host copies and the image), checked before anything renders (the auto sampler's pilot comes
+// first); Renderer::render checks it again with the wave's buffers.
+void check_film_memory(const cl::Device& device, uint64_t pixels, const std::string& what);
+
 } // namespace canopy

@@ -84,14 +84,14 @@ struct FilmSettings {
   float image_scale = 1.0f;
 };
 
-// Defaults show the renderer at its best: the estimator with the best worst case over the
-// shipped scenes in docs/results.md ("The default estimator": Liu et al.'s BRDF-oriented MIS at
-// glossy points, the light tree with adaptive splitting at the measured threshold elsewhere), and
+// Defaults show the renderer at its best: "auto", a pilot render that picks power, tree or brdf-mis
+// (with splitting at the measured threshold) per scene (render/auto_sampler.h), within 10% of the
+// best configuration on every shipped scene in docs/results.md ("The default estimator"), and
 // paths of pbrt-v4's default depth.
 struct IntegratorSettings {
   int spp = 16;      // samples per pixel, 1 .. kMaxSpp
   int max_depth = 5; // path vertices that sample lights (pbrt-v4's maxdepth): 1 = direct light
-  std::string light_sampler = "brdf-mis";             // a name of kLightSamplerNames
+  std::string light_sampler = "auto";                 // "auto" or a name of kLightSamplerNames
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD; // adaptive splitting threshold in [0, 1]
   int max_cut = kDefaultMaxCut; // tree-split: at most this many lights per shading point
   uint32_t seed = 1;

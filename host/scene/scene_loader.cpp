@@ -168,7 +168,7 @@ size_t Builder::add_mesh(const Mesh& mesh, const Transform& xf) {
     } else if (!s.triangle_normals.empty()) {
       s.triangle_normals.push_back(-1);
     }
-    if (!s.triangle_uvs.empty()) {
+    if (has_uv || !s.triangle_uvs.empty()) {
       float2 uv[3] = {default_uv[0], default_uv[1], default_uv[2]};
       if (has_uv) {
         // A triangle lacking uv at a vertex takes the default at all three.
