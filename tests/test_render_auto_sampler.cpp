@@ -61,10 +61,14 @@ TEST(AutoSampler, ThePilotRanksByEfficiencyAndLeavesTheWinnerSet) {
   EXPECT_EQ(renderer.options().split_threshold, choice.chosen.options.split_threshold);
   EXPECT_GE(choice.pilot_seconds, choice.candidates[0].seconds);
   EXPECT_NE(describe(choice).find("auto: " + choice.chosen.label), std::string::npos);
+  // The pilot's renders are not the render's: its statistics start from zero.
+  EXPECT_EQ(renderer.stats().samples, 0u);
+  EXPECT_EQ(renderer.stats().render_seconds, 0.0);
   // The renderer renders with it afterwards.
   RenderSettings rs;
   rs.spp = 2;
   Film film = renderer.render(rs);
+  EXPECT_EQ(renderer.stats().samples, uint64_t(2 * 64 * 48));
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
   EXPECT_EQ(film.sum.size(), size_t(64 * 48));
 }

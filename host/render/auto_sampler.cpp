@@ -159,6 +159,7 @@ AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base,
   }
   out.chosen = *best;
   if (best != out.candidates.end() - 1) renderer.set_light_sampler(best->options);
+  renderer.reset_render_stats();
   out.pilot_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return out;
 }

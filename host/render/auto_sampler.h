@@ -36,15 +36,15 @@ struct AutoChoice {
 std::vector<PilotResult> auto_candidates(const RendererOptions& base);
 
 // The pilot: the scene at a lower resolution (an eighth of the film's pixels, at most 2^16), 1 + 2m
-// spp per candidate (two timed renders of m >= 2 passes, ~0.08 s each) after an untimed warm-up. Each pixel's sample variance, averaged over the pixels
-// whose camera rays saw no emitter (their noise is the emitter's edge, the same for every
-// sampler), and the time per sample pass (the faster of the two timed renders, robust to a
-// moment of other load on the machine) give the estimated efficiency. A
-// candidate whose image mean is more than 4 standard errors below the median candidate's has
-// missed rare large samples (its measured variance is then far too low) and is not ranked. Leaves
-// `renderer` set to the winner, at the scene's film size. The choice depends on timings, so it can
-// differ between runs where two candidates are close; every candidate is unbiased, so only the
-// noise can change.
+// spp per candidate (two timed renders of m >= 2 passes, ~0.08 s each) after an untimed warm-up.
+// Each pixel's sample variance, averaged over the pixels whose camera rays saw no emitter (their
+// noise is the emitter's edge, the same for every sampler), and the time per sample pass (the
+// faster of the two timed renders, robust to a moment of other load on the machine) give the
+// estimated efficiency. A candidate whose image mean is more than 4 standard errors below the
+// median candidate's has missed rare large samples (its measured variance is then far too low) and
+// is not ranked. Leaves `renderer` set to the winner, at the scene's film size, its render
+// statistics zeroed. The choice depends on timings, so it can differ between runs where two
+// candidates are close; every candidate is unbiased, so only the noise can change.
 AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base, uint32_t seed);
 
 // One line for logs: "auto: tree (pilot 0.84 s; efficiency power 12.3, tree 45.6, ...)".

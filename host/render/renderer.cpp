@@ -199,6 +199,18 @@ void Renderer::set_film_size(int width, int height) {
   camera_ = upload_buffer(rt_.context(), cam);
 }
 
+void Renderer::reset_render_stats() {
+  RenderStats fresh;
+  fresh.build_seconds = stats_.build_seconds;
+  fresh.light_tree_seconds = stats_.light_tree_seconds;
+  fresh.upload_seconds = stats_.upload_seconds;
+  fresh.compile_seconds = stats_.compile_seconds;
+  fresh.kernel_options = stats_.kernel_options;
+  fresh.emission_exponent = stats_.emission_exponent;
+  fresh.cut_size_histogram.assign(kCutBins, 0);
+  stats_ = std::move(fresh);
+}
+
 void Renderer::set_light_sampler(const RendererOptions& options) {
   auto t0 = Clock::now();
   // The geometry, textures and the rest stay; only the sampler's data and the kernels change.

@@ -151,6 +151,9 @@ public:
   // view): the auto sampler's pilot runs at a reduced resolution. The scene's film size is the
   // initial one.
   void set_film_size(int width, int height);
+  // Zeroes what render() accumulates (time, counts, stage timings, histogram), keeping the build,
+  // upload and compile figures: the auto sampler's pilot renders are not the render's.
+  void reset_render_stats();
 
 private:
   void compile_kernels(); // for options_ and sampler_: sets program_, brdf_stages_, volume_stages_
