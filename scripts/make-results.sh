@@ -60,8 +60,10 @@ mkdir -p "$WORK" "$DOCS"
 
 # The configurations compared: power (alias table), the light tree without and with splitting
 # (tree-split at the scene's threshold), Liu et al.'s BRDF-oriented sampling with MIS (on a
-# scene without a glossy material it renders as tree-split), and BSDF sampling alone.
-SAMPLERS=${SAMPLERS:-power,tree,tree-split,brdf-mis,bsdf}
+# scene without a glossy material it renders as tree-split), BSDF sampling alone, and the
+# default, auto (a pilot picks power, tree or brdf-mis at threshold 0.25 per scene; its pilot's
+# seconds are in -configs.csv, apart from the render seconds).
+SAMPLERS=${SAMPLERS:-power,tree,tree-split,brdf-mis,bsdf,auto}
 
 # Budgets. T: equal time, seconds per render (x SEEDS renders per configuration); R: reference
 # seconds (per depth). Films are scaled (--film-scale) so that a render of T seconds holds a few
@@ -86,8 +88,9 @@ city           | 0.5  | 1 | tree-split:0.5 | 60 | 0
 mesh-light     | 0.5  | 1 | tree-split:0.5 | 60 | 0
 spiral-fog     | 0.5  | 1 | tree-split:0.5 | 60 | 0
 city-fog       | 0.25 | 1 | tree-split:0.5 | 60 | 0
+outdoor        | 0.5  | 1 | tree-split:0.5 | 60 | 0
 "
-ALL_SCENES="default glossy-cornell showroom cornell-1k cornell-1m plane-10k spiral-10k city mesh-light spiral-fog city-fog"
+ALL_SCENES="default glossy-cornell showroom cornell-1k cornell-1m plane-10k spiral-10k city mesh-light spiral-fog city-fog outdoor"
 SCENES=${SCENES:-$ALL_SCENES}
 
 start=$(date +%s)

@@ -36,6 +36,8 @@ SCENES = [
                    "Fig. 6, 15, 16)"),
     ("spiral-fog", "The spiral in a homogeneous medium (issue 13)"),
     ("city-fog", "The city in fog (issue 13)"),
+    ("outdoor", "Late afternoon: a sun, an image sky, 400 garden lamps, textured ground and a "
+                "brushed gold box (issue 22)"),
 ]
 TAGS = [("d1", "Direct light (`--max-depth 1`)"), ("dfull", "Full paths (the scene's depth)")]
 CLOSE = 0.10  # within 10% of the best's efficiency

@@ -112,7 +112,7 @@ struct RenderSettings {
 
 struct RendererOptions {
   // The library's baseline for code that builds a renderer directly (the tests); the product's
-  // default is the scene's (IntegratorSettings::light_sampler, brdf-mis: docs/results.md).
+  // default is the scene's (IntegratorSettings::light_sampler, "auto": render/auto_sampler.h).
   std::string light_sampler = "tree-split"; // a name of kLightSamplerNames
   float split_threshold = LT_DEFAULT_SPLIT_THRESHOLD;
   int max_cut = kDefaultMaxCut;       // cut size cap per shading point (tree-split)
