@@ -167,25 +167,28 @@ def default_section(text_path, candidates, table_names):
     out += ["Non-emitter efficiency over each table's best (1 = best; * within 10% or "
             "overlapping intervals; u unresolved; - not run):", ""]
     out.append("| configuration | " + " | ".join(table_names) +
-               " | worst | meets the rule everywhere |")
-    out.append("|---|" + "---|" * (len(table_names) + 2))
+               " | worst | meets the rule everywhere | tables run |")
+    out.append("|---|" + "---|" * (len(table_names) + 3))
     for label, per in candidates.items():
-        cells, every, worst = [], True, float("inf")
+        cells, every, worst, run = [], True, float("inf"), 0
         for t in table_names:
             ratio, verdict = per.get(t, (float("nan"), "-"))
+            run += t in per
             if verdict == "unresolved":
                 cells.append("u")
             elif not math.isfinite(ratio):
                 cells.append("-")
-                every = False
+                every = every and t not in per  # a table it was not run in is not a verdict
             else:
                 ok = verdict in ("best", "within 10%", "overlaps")
                 worst = min(worst, ratio)
                 every = every and ok
                 cells.append(f"{ratio:.2f}" + ("*" if ok and verdict != "best" else ""))
         worst_cell = f"{worst:.2f}" if math.isfinite(worst) else "-"
+        verdict = ("yes" if every else "no") if run == len(table_names) else \
+            ("yes, where run" if every else "no")
         out.append(f"| {label} | " + " | ".join(cells) +
-                   f" | {worst_cell} | {'yes' if every else 'no'} |")
+                   f" | {worst_cell} | {verdict} | {run} of {len(table_names)} |")
     return out + [""]
 
 
