@@ -463,6 +463,7 @@ int run_render(const RenderArgs& args) {
         a["candidates"].push_back({{"label", c.label},
                                    {"variance", c.variance},
                                    {"seconds", c.seconds},
+                                   {"pass_seconds", c.pass_seconds},
                                    {"efficiency", c.efficiency}});
       j["auto"] = a;
     }

@@ -115,20 +115,44 @@ AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base,
     Film film = renderer.render(rs);
     const double t1 = std::chrono::duration<double>(Clock::now() - r0).count();
     const int m = int(std::clamp(std::ceil(kTimedSeconds / std::max(t1, 1e-4)), 2.0, 32.0));
-    double per_pass = 0.0, timed = 0.0;
-    for (int r = 0; r < 2; ++r) {
-      rs.first_sample = 1 + r * m;
-      rs.spp = m;
-      r0 = Clock::now();
-      add_samples(film, renderer.render(rs));
-      const double t = std::chrono::duration<double>(Clock::now() - r0).count();
-      per_pass = r == 0 ? t / m : std::min(per_pass, t / m);
-      timed += t;
+    double timed = 0.0;
+    auto time_passes = [&](int first, int passes, Film* into) {
+      RenderSettings ts = rs;
+      ts.spp = passes;
+      double best = 0.0;
+      for (int r = 0; r < 2; ++r) {
+        ts.first_sample = first + r * passes;
+        auto start = Clock::now();
+        Film f = renderer.render(ts);
+        const double t = std::chrono::duration<double>(Clock::now() - start).count();
+        if (into) add_samples(*into, f);
+        best = r == 0 ? t / passes : std::min(best, t / passes);
+        timed += t;
+      }
+      return best;
+    };
+    const double per_pass = time_passes(1, m, &film);
+    // The time of a pass at the film's size. A pass costs a fixed part (kernel launches, one per
+    // stage and split pass: more for a splitting sampler) and a part per pixel. At the pilot's
+    // size the fixed part weighs up to 8x more than in the render, which favours the sampler with
+    // the fewest launches (spiral-fog: tree chosen at 0.82x brdf-mis'). So a pass is timed at a
+    // quarter of the pilot's pixels too (the same view), and the affine fit through the two
+    // sizes is read off at the film's pixels.
+    const int qw = std::max(4, pw / 2), qh = std::max(4, ph / 2);
+    const double pilot_px = double(pw) * double(ph), small_px = double(qw) * double(qh);
+    double film_pass = per_pass;
+    if (small_px < pilot_px) {
+      renderer.set_film_size(qw, qh);
+      const double small_pass = time_passes(1, m, nullptr);
+      renderer.set_film_size(pw, ph);
+      const double per_pixel = std::max(0.0, (per_pass - small_pass) / (pilot_px - small_px));
+      film_pass = per_pass + per_pixel * (double(fw) * double(fh) - pilot_px);
     }
     stats.push_back(pilot_stats(film));
     c.variance = stats.back().variance;
     c.seconds = t1 + timed;
-    c.efficiency = c.variance > 0.0 && per_pass > 0.0 ? 1.0 / (c.variance * per_pass) : 0.0;
+    c.pass_seconds = film_pass;
+    c.efficiency = c.variance > 0.0 && film_pass > 0.0 ? 1.0 / (c.variance * film_pass) : 0.0;
   }
   renderer.set_film_size(fw, fh);
   // Every candidate is unbiased, so their image means agree within their standard errors unless
