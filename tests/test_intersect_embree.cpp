@@ -70,11 +70,12 @@ TEST_F(IntersectTest, BvhIsWellFormed) {
   std::vector<int> seen(prims_->size(), 0);
   std::vector<int> parents(bvh_->nodes.size(), 0);
   for (const BvhNode& n : bvh_->nodes)
-    for (int lane = 0; lane < 4; ++lane) {
-      int c = i4_get(n.child, lane);
+    for (int lane = 0; lane < BVH_WIDTH; ++lane) {
+      const int g = lane / 4, j = lane % 4;
+      int c = bvh_lane_child(&n, lane);
       if (c == BVH_EMPTY) continue;
-      float3 lo = make_float3(f4_get(n.min_x, lane), f4_get(n.min_y, lane), f4_get(n.min_z, lane));
-      float3 hi = make_float3(f4_get(n.max_x, lane), f4_get(n.max_y, lane), f4_get(n.max_z, lane));
+      float3 lo = make_float3(f4_get(n.min_x[g], j), f4_get(n.min_y[g], j), f4_get(n.min_z[g], j));
+      float3 hi = make_float3(f4_get(n.max_x[g], j), f4_get(n.max_y[g], j), f4_get(n.max_z[g], j));
       if (c >= 0) {
         ASSERT_LT(size_t(c), bvh_->nodes.size());
         parents[size_t(c)]++;

@@ -55,9 +55,9 @@ void primitive_bounds(const Primitive& p, float3& lo, float3& hi) {
 // Temporary tree produced by Embree's callbacks (allocated in Embree's thread-local arenas).
 struct BuildNode {
   bool leaf;
-  int count;           // leaf: primitive count; interior: child count
-  RTCBounds bounds[4]; // interior: child bounds
-  BuildNode* children[4];
+  int count;                   // leaf: primitive count; interior: child count
+  RTCBounds bounds[BVH_WIDTH]; // interior: child bounds
+  BuildNode* children[BVH_WIDTH];
   const unsigned* ids; // leaf: primitive ids
 };
 
@@ -70,14 +70,14 @@ void* create_node(RTCThreadLocalAllocator alloc, unsigned int count, void*) {
 
 void set_children(void* node, void** children, unsigned int count, void*) {
   auto* n = static_cast<BuildNode*>(node);
-  for (unsigned i = 0; i < 4; ++i)
+  for (unsigned i = 0; i < BVH_WIDTH; ++i)
     n->children[i] = i < count ? static_cast<BuildNode*>(children[i]) : nullptr;
   n->count = int(count);
 }
 
 void set_bounds(void* node, const RTCBounds** bounds, unsigned int count, void*) {
   auto* n = static_cast<BuildNode*>(node);
-  for (unsigned i = 0; i < count && i < 4; ++i)
+  for (unsigned i = 0; i < count && i < BVH_WIDTH; ++i)
     n->bounds[i] = *bounds[i];
 }
 
@@ -100,16 +100,18 @@ RTCBounds empty_bounds() {
 }
 
 void set_lane(BvhNode& n, int lane, const RTCBounds& b, int code) {
-  float* f[6] = {&n.min_x.x, &n.min_y.x, &n.min_z.x, &n.max_x.x, &n.max_y.x, &n.max_z.x};
+  const int g = lane / 4, k = lane % 4;
+  float* f[6] = {&n.min_x[g].x, &n.min_y[g].x, &n.min_z[g].x,
+                 &n.max_x[g].x, &n.max_y[g].x, &n.max_z[g].x};
   const float v[6] = {b.lower_x, b.lower_y, b.lower_z, b.upper_x, b.upper_y, b.upper_z};
-  for (int k = 0; k < 6; ++k)
-    f[k][lane] = v[k];
-  (&n.child.x)[lane] = code;
+  for (int c = 0; c < 6; ++c)
+    f[c][k] = v[c];
+  (&n.child[g].x)[k] = code;
 }
 
 BvhNode empty_node() {
   BvhNode n{};
-  for (int lane = 0; lane < 4; ++lane)
+  for (int lane = 0; lane < BVH_WIDTH; ++lane)
     set_lane(n, lane, empty_bounds(), BVH_EMPTY);
   return n;
 }
@@ -158,8 +160,8 @@ struct Flattener {
     int at = int(out.nodes.size());
     out.nodes.push_back(empty_node());
     out.depth = std::max(out.depth, depth + 1);
-    int per = (count + 3) / 4;
-    for (int lane = 0, start = 0; lane < 4 && start < count; ++lane, start += per) {
+    int per = (count + BVH_WIDTH - 1) / BVH_WIDTH;
+    for (int lane = 0, start = 0; lane < BVH_WIDTH && start < count; ++lane, start += per) {
       int c = std::min(per, count - start);
       int code = leaf(ids + start, c, depth + 1);
       set_lane(out.nodes[size_t(at)], lane, bounds_of(ids + start, c), code);
@@ -263,7 +265,7 @@ Bvh build_bvh(const std::vector<Primitive>& prims) {
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.byteSize = sizeof(args);
   args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
-  args.maxBranchingFactor = 4;
+  args.maxBranchingFactor = BVH_WIDTH;
   args.maxDepth = BVH_MAX_DEPTH - 4; // headroom for splitting oversized leaves
   // Leaves are tested four primitives at a time (LeafBlock): SAH counts their cost in blocks of
   // 4, and leaves of up to 8 fill blocks with 3.0 triangles on average (1.26 with leaves of 1-4

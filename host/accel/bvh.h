@@ -1,6 +1,7 @@
 // Geometry acceleration: the primitives of a scene (its triangles plus the shapes of analytic area
-// lights), a 4-wide BVH over them built by Embree's rtcBuildBVH (SAH) and flattened for the
-// intersect kernels, and an Embree RTCScene used as the reference intersector in tests/benchmarks.
+// lights), a BVH_WIDTH-wide (8) BVH over them built by Embree's rtcBuildBVH (SAH) and flattened for
+// the intersect kernels, and an Embree RTCScene used as the reference intersector in
+// tests/benchmarks.
 #pragma once
 
 #include "scene/scene.h"
@@ -38,8 +39,8 @@ struct SceneGeometry {
 // Scene::shading_normals), -1 for flat triangles and light shapes.
 std::vector<Primitive> build_primitives(Scene& scene, std::vector<Material>& materials);
 
-// 4-wide SAH BVH over `prims`, via rtcBuildBVH; depth limited (BVH_MAX_DEPTH) so the kernels'
-// fixed traversal stack never overflows.
+// BVH_WIDTH-wide SAH BVH over `prims`, via rtcBuildBVH; depth limited (BVH_MAX_DEPTH) so the
+// kernels' fixed traversal stack never overflows.
 Bvh build_bvh(const std::vector<Primitive>& prims);
 
 SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& materials);
