@@ -189,9 +189,10 @@ INLINE int bvh_lane_child(const GLOBAL BvhNode* n, int lane) {
 // A node's lanes for the traversal: each lane's entry distance (INFINITY: missed or empty) and
 // child code into lane_t / lane_c, and as bit masks the lanes entered before tmax (returned) and
 // those of them that are leaves (*leaves). On the device an 8-wide node is one float8 per
-// coordinate (PoCL emits AVX: 1.3x the speed of shadow rays and 1.1x of closest hits against two
-// float4 groups, docs/performance.md); the host tests it in groups of four with
-// bvh_node_entry. Both do the same operations lane by lane, and the tests compare them.
+// coordinate, which PoCL compiles to AVX: against the 4-wide tree, closest hits 1.14-1.16x and
+// shadow rays 1.16-1.29x faster, where the same 8-wide tree tested as two float4 groups gained
+// nothing (docs/performance.md). The host tests the lanes in groups of four (bvh_node_entry);
+// both do the same operations lane by lane, and the tests compare them.
 INLINE int bvh_node_lanes(const GLOBAL BvhNode* n, float3 o, float3 inv_d, float tmin,
                           float tmax, float* lane_t, int* lane_c, int* leaves) {
 #if defined(__OPENCL_C_VERSION__) && BVH_WIDTH == 8
