@@ -139,8 +139,8 @@ typedef struct Primitive {
 // lanes: lane i = 4 g + k is element k of group g, so one node's boxes are tested four at a time
 // with float4 arithmetic. child lane >= 0: an interior node; BVH_EMPTY: unused lane; other negative
 // values: a leaf of the blocks leaf_blocks[first .. first + count), see bvh_leaf_*. An 8-wide tree
-// has about half the levels of a 4-wide one, so a ray meets half as many dependent node loads;
-// its 256-byte node spans four adjacent cache lines, fetched together.
+// has fewer levels than a 4-wide one, so a ray meets fewer dependent node loads; its 256-byte
+// node spans four adjacent cache lines (cl/geometry.h bvh_node_lanes tests it as float8).
 #define BVH_WIDTH 8
 #define BVH_GROUPS (BVH_WIDTH / 4)
 typedef struct BvhNode {
