@@ -52,7 +52,7 @@ TEST(AutoSampler, ThePilotRanksByEfficiencyAndLeavesTheWinnerSet) {
   for (const PilotResult& c : choice.candidates) {
     EXPECT_GT(c.variance, 0.0) << c.label;
     EXPECT_GT(c.seconds, 0.0) << c.label;
-    // the efficiency is that of a pass over the whole film (extrapolated from the pilot's sizes)
+    // the efficiency is that of a pass over the whole film
     EXPECT_GT(c.pass_seconds, 0.0) << c.label;
     EXPECT_DOUBLE_EQ(c.efficiency, 1.0 / (c.variance * c.pass_seconds)) << c.label;
     EXPECT_LE(c.efficiency, choice.chosen.efficiency) << c.label;

@@ -25,8 +25,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Each of the pilot's two timed renders of a candidate lasts about this long (or 2 spp, if longer).
-constexpr double kTimedSeconds = 0.08;
+// A candidate whose first timed render took less than this is timed a second time.
+constexpr double kTimedSeconds = 0.25;
 
 bool same_sampler(const RendererOptions& a, const RendererOptions& b) {
   return a.light_sampler == b.light_sampler && a.split_threshold == b.split_threshold &&
@@ -87,14 +87,16 @@ AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base,
   const auto t0 = Clock::now();
   AutoChoice out;
   out.candidates = auto_candidates(base);
-  // The pilot film: the scene's view at a lower resolution, an eighth of its pixels (at most
-  // 2^16), so that every part of the image counts as it does in the render.
+  // The pilot renders the film itself: a pass's cost depends on the film's size (its kernel
+  // launches are shared by all of a wave's paths, and a splitting sampler's waves hold fewer paths
+  // than the others'), which renders at a lower resolution misjudged by 10-20% either way
+  // (docs/design.md, "Choosing the estimator per scene"). Each timed render holds at least one
+  // full wave of paths, as the render's passes do.
   const int fw = renderer.scene().film.width, fh = renderer.scene().film.height;
-  const double pixels = std::min(double(fw) * double(fh) / 8.0, 65536.0);
-  const double scale = std::min(1.0, std::sqrt(pixels / (double(fw) * double(fh))));
-  const int pw = std::max(8, int(std::lround(fw * scale)));
-  const int ph = std::max(8, int(std::lround(fh * scale)));
-  renderer.set_film_size(pw, ph);
+  renderer.set_film_size(fw, fh);
+  const double npix = double(fw) * double(fh);
+  const RenderSettings defaults;
+  const int passes = int(std::clamp(std::ceil(double(defaults.wave_size) / npix), 1.0, 256.0));
   std::vector<PilotStats> stats;
   for (PilotResult& c : out.candidates) {
     if (&c != &out.candidates.front() || !same_sampler(renderer.options(), c.options))
@@ -102,59 +104,34 @@ AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base,
     // Untimed: PoCL compiles each kernel on its first launch (or loads it from its cache).
     RenderSettings warm;
     warm.seed = seed + 1;
-    warm.window = PixelWindow{0, 0, std::min(pw, 16), std::min(ph, 16)};
+    warm.window = PixelWindow{0, 0, std::min(fw, 16), std::min(fh, 16)};
     renderer.render(warm);
-    // Samples [0, 1), then two timed renders of m passes each, [1, 1 + m) and [1 + m, 1 + 2m), m
-    // (>= 2) chosen from the first so that each lasts ~kTimedSeconds. The time per pass is the
-    // smaller of the two: a pilot timed once on a machine with other work misjudged 2x
-    // differences (glossy-cornell).
+    // Samples [0, passes), timed; when that took less than kTimedSeconds, samples
+    // [passes, 2 passes) too, and the faster of the two renders gives the time per pass (a pilot
+    // timed once, on a machine with other work, misjudged 2x differences).
     RenderSettings rs;
     rs.seed = seed;
-    rs.spp = 1;
-    auto r0 = Clock::now();
-    Film film = renderer.render(rs);
-    const double t1 = std::chrono::duration<double>(Clock::now() - r0).count();
-    const int m = int(std::clamp(std::ceil(kTimedSeconds / std::max(t1, 1e-4)), 2.0, 32.0));
-    double timed = 0.0;
-    auto time_passes = [&](int first, int passes, Film* into) {
-      RenderSettings ts = rs;
-      ts.spp = passes;
-      double best = 0.0;
-      for (int r = 0; r < 2; ++r) {
-        ts.first_sample = first + r * passes;
-        auto start = Clock::now();
-        Film f = renderer.render(ts);
-        const double t = std::chrono::duration<double>(Clock::now() - start).count();
-        if (into) add_samples(*into, f);
-        best = r == 0 ? t / passes : std::min(best, t / passes);
-        timed += t;
-      }
-      return best;
-    };
-    const double per_pass = time_passes(1, m, &film);
-    // The time of a pass at the film's size. A pass costs a fixed part (kernel launches, one per
-    // stage and split pass: more for a splitting sampler) and a part per pixel. At the pilot's
-    // size the fixed part weighs up to 8x more than in the render, which favours the sampler with
-    // the fewest launches (spiral-fog: tree chosen at 0.82x brdf-mis'). So a pass is timed at a
-    // quarter of the pilot's pixels too (the same view), and the affine fit through the two
-    // sizes is read off at the film's pixels.
-    const int qw = std::max(4, pw / 2), qh = std::max(4, ph / 2);
-    const double pilot_px = double(pw) * double(ph), small_px = double(qw) * double(qh);
-    double film_pass = per_pass;
-    if (small_px < pilot_px) {
-      renderer.set_film_size(qw, qh);
-      const double small_pass = time_passes(1, m, nullptr);
-      renderer.set_film_size(pw, ph);
-      const double per_pixel = std::max(0.0, (per_pass - small_pass) / (pilot_px - small_px));
-      film_pass = per_pass + per_pixel * (double(fw) * double(fh) - pilot_px);
+    rs.spp = passes;
+    double timed = 0.0, per_pass = 0.0;
+    Film film;
+    for (int r = 0; r < 2 && (r == 0 || timed < kTimedSeconds); ++r) {
+      rs.first_sample = r * passes;
+      const auto start = Clock::now();
+      Film f = renderer.render(rs);
+      const double t = std::chrono::duration<double>(Clock::now() - start).count();
+      per_pass = r == 0 ? t / passes : std::min(per_pass, t / passes);
+      timed += t;
+      if (r == 0)
+        film = std::move(f);
+      else
+        add_samples(film, f);
     }
     stats.push_back(pilot_stats(film));
     c.variance = stats.back().variance;
-    c.seconds = t1 + timed;
-    c.pass_seconds = film_pass;
-    c.efficiency = c.variance > 0.0 && film_pass > 0.0 ? 1.0 / (c.variance * film_pass) : 0.0;
+    c.seconds = timed;
+    c.pass_seconds = per_pass;
+    c.efficiency = c.variance > 0.0 && per_pass > 0.0 ? 1.0 / (c.variance * per_pass) : 0.0;
   }
-  renderer.set_film_size(fw, fh);
   // Every candidate is unbiased, so their image means agree within their standard errors unless
   // one missed rare large samples (power on a city: the near lights are almost never picked): its
   // variance, measured from the samples it drew, is then far too low. Such a candidate (mean more

@@ -18,7 +18,7 @@ struct PilotResult {
   RendererOptions options;
   double variance = 0.0;     // per sample: the mean over channels and non-emitter pixels
   double seconds = 0.0;      // of the pilot renders
-  double pass_seconds = 0.0; // a sample pass over the film, extrapolated from the pilot's
+  double pass_seconds = 0.0; // a sample pass over the film, timed in the pilot
   double efficiency = 0.0;   // 1 / (variance x pass_seconds); 0 if variance is 0
   // Its pilot image's mean is far below the others': it missed rare large samples, so its
   // measured variance is too low (see choose_light_sampler). Not ranked.
@@ -36,19 +36,16 @@ struct AutoChoice {
 // glossy material); each keeps base's other settings.
 std::vector<PilotResult> auto_candidates(const RendererOptions& base);
 
-// The pilot: the scene at a lower resolution (an eighth of the film's pixels, at most 2^16), 1 + 2m
-// spp per candidate (two timed renders of m >= 2 passes, ~0.08 s each) after an untimed warm-up.
-// Each pixel's sample variance, averaged over the pixels whose camera rays saw no emitter (their
-// noise is the emitter's edge, the same for every sampler), and the time of a sample pass over the
-// film give the estimated efficiency. That time is extrapolated from passes timed at the pilot's
-// size and at a quarter of it (an affine fit in the pixel count: a pass's fixed cost, its kernel
-// launches, weighs more in a small pilot than in the render); each is the faster of two timed
-// renders, robust to a moment of other load on the machine. A candidate whose image mean is more
-// than 4 standard errors below the median candidate's has missed rare large samples (its measured
-// variance is then far too low) and is not ranked. Leaves `renderer` set to the winner, at the
-// scene's film size, its render statistics zeroed. The choice depends on timings, so it can differ
-// between runs where two candidates are close; every candidate is unbiased, so only the noise can
-// change.
+// The pilot: per candidate, after an untimed warm-up, a timed render of the film itself with
+// enough passes to fill one wave (2^18 paths: 4 passes of a 256x256 film, 1 of a larger one), and
+// a second one if the first took less than 0.25 s. The faster gives the time per pass (robust to a
+// moment of other load on the machine); each pixel's sample variance over both, averaged over the
+// pixels whose camera rays saw no emitter (their noise is the emitter's edge, the same for every
+// sampler), gives the variance per sample. A candidate whose image mean is more than 4 standard
+// errors below the median candidate's has missed rare large samples (its measured variance is then
+// far too low) and is not ranked. Leaves `renderer` set to the winner, at the scene's film size,
+// its render statistics zeroed. The choice depends on timings, so it can differ between runs where
+// two candidates are close; every candidate is unbiased, so only the noise can change.
 AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base, uint32_t seed);
 
 // One line for logs: "auto: tree (pilot 0.84 s; efficiency power 12.3, tree 45.6, ...)".
