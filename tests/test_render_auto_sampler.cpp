@@ -95,7 +95,7 @@ TEST(AutoSampler, ABlackScenePicksTheFastest) {
 }
 
 // One dim light close over the floor outshines 65,536 distant ones there, but holds 6e-9 of the
-// power: power sampling picks it about never in a pilot of at most ~10^5 samples, so its image
+// power: power sampling picks it about never in a pilot of at most ~5·10^5 samples, so its image
 // mean falls far below the others' and its measured variance means nothing. It is not ranked.
 TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRanked) {
   const char* json = R"({
@@ -117,4 +117,38 @@ TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRanked) {
   EXPECT_FALSE(choice.candidates[1].missed_tail) << describe(choice);
   EXPECT_NE(choice.chosen.label, "power");
   EXPECT_NE(describe(choice).find("missed its tail"), std::string::npos);
+}
+
+// The pilot switches samplers on one renderer, and a tree sampler after another keeps the light
+// tree (it depends on the lights alone): the image after each switch must be the very image of a
+// renderer built for that sampler.
+TEST(AutoSampler, ASwitchedRendererRendersAsAFreshOne) {
+  Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
+  ClRuntime rt;
+  RendererOptions tree;
+  tree.light_sampler = "tree";
+  RendererOptions split = auto_candidates(RendererOptions{}).back().options; // brdf-mis/split
+  RendererOptions power = auto_candidates(RendererOptions{}).front().options;
+  RenderSettings rs;
+  rs.spp = 3;
+  rs.seed = 5;
+  auto expect_same = [&](const Film& a, const Film& b, const char* what) {
+    ASSERT_EQ(a.sum.size(), b.sum.size());
+    for (size_t i = 0; i < a.sum.size(); ++i) {
+      ASSERT_EQ(a.sum[i].x, b.sum[i].x) << what << " pixel " << i;
+      ASSERT_EQ(a.sum[i].y, b.sum[i].y) << what << " pixel " << i;
+      ASSERT_EQ(a.sum[i].z, b.sum[i].z) << what << " pixel " << i;
+      ASSERT_EQ(a.sumsq[i].x, b.sumsq[i].x) << what << " pixel " << i;
+    }
+  };
+  Renderer switched(rt, scene, tree);
+  switched.set_light_sampler(split); // keeps the tree
+  Film a = switched.render(rs);
+  Renderer fresh_split(rt, scene, split);
+  expect_same(a, fresh_split.render(rs), "tree -> brdf-mis/split");
+  switched.set_light_sampler(power); // drops it
+  switched.set_light_sampler(tree);  // builds it again
+  Film b = switched.render(rs);
+  Renderer fresh_tree(rt, scene, tree);
+  expect_same(b, fresh_tree.render(rs), "-> power -> tree");
 }

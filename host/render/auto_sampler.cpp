@@ -25,9 +25,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A candidate whose first timed render took less than this is timed a second time.
-constexpr double kTimedSeconds = 0.25;
-
 bool same_sampler(const RendererOptions& a, const RendererOptions& b) {
   return a.light_sampler == b.light_sampler && a.split_threshold == b.split_threshold &&
          a.max_cut == b.max_cut && a.orientation_term == b.orientation_term && a.mis == b.mis;
@@ -101,30 +98,24 @@ AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base,
   for (PilotResult& c : out.candidates) {
     if (&c != &out.candidates.front() || !same_sampler(renderer.options(), c.options))
       renderer.set_light_sampler(c.options);
-    // Untimed: PoCL compiles each kernel on its first launch (or loads it from its cache).
-    RenderSettings warm;
-    warm.seed = seed + 1;
-    warm.window = PixelWindow{0, 0, std::min(fw, 16), std::min(fh, 16)};
-    renderer.render(warm);
-    // Samples [0, passes), timed; when that took less than kTimedSeconds, samples
-    // [passes, 2 passes) too, and the faster of the two renders gives the time per pass (a pilot
-    // timed once, on a machine with other work, misjudged 2x differences).
+    // Untimed, samples [0, 1): PoCL compiles each kernel on its first launch (or loads it from its
+    // cache), and the first render over the film touches the scene's memory for the first time.
     RenderSettings rs;
     rs.seed = seed;
+    Film film = renderer.render(rs);
+    // Samples [1, 1 + passes) and [1 + passes, 1 + 2 passes), each render timed: the faster gives
+    // the time per pass. The first may allocate the wave's buffers (render() keeps them for the
+    // next), and a pilot timed once, on a machine with other work, misjudged 2x differences.
     rs.spp = passes;
     double timed = 0.0, per_pass = 0.0;
-    Film film;
-    for (int r = 0; r < 2 && (r == 0 || timed < kTimedSeconds); ++r) {
-      rs.first_sample = r * passes;
+    for (int r = 0; r < 2; ++r) {
+      rs.first_sample = 1 + r * passes;
       const auto start = Clock::now();
       Film f = renderer.render(rs);
       const double t = std::chrono::duration<double>(Clock::now() - start).count();
       per_pass = r == 0 ? t / passes : std::min(per_pass, t / passes);
       timed += t;
-      if (r == 0)
-        film = std::move(f);
-      else
-        add_samples(film, f);
+      add_samples(film, f);
     }
     stats.push_back(pilot_stats(film));
     c.variance = stats.back().variance;
@@ -169,8 +160,8 @@ std::string describe(const AutoChoice& choice) {
   std::string s = fmt::format("auto: {} (pilot {:.2f} s; efficiency", choice.chosen.label,
                               choice.pilot_seconds);
   for (size_t i = 0; i < choice.candidates.size(); ++i)
-    s += fmt::format("{} {} {:.4g}{}", i ? "," : "", choice.candidates[i].label,
-                     choice.candidates[i].efficiency,
+    s += fmt::format("{} {} {:.4g} ({:.3g} s/pass){}", i ? "," : "", choice.candidates[i].label,
+                     choice.candidates[i].efficiency, choice.candidates[i].pass_seconds,
                      choice.candidates[i].missed_tail ? " (missed its tail: not ranked)" : "");
   return s + ")";
 }

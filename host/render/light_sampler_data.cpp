@@ -10,7 +10,7 @@ namespace canopy {
 
 LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const std::string& name,
                                          float split_threshold, int max_cut, bool orientation_term,
-                                         const BrdfSettings& brdf) {
+                                         const BrdfSettings& brdf, LightTree* built) {
   LightSamplerData d;
   d.kind = light_sampler_from_name(name);
   d.brdf = brdf;
@@ -26,7 +26,10 @@ LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const
   if (d.kind == SAMPLER_TREE || d.kind == SAMPLER_TREE_SPLIT || d.kind == SAMPLER_EXHAUSTIVE ||
       d.kind == SAMPLER_BRDF_MIS || d.kind == SAMPLER_BRDF_ORIENTED) {
     auto t0 = std::chrono::steady_clock::now();
-    d.tree = build_light_tree(lights);
+    if (built && built->num_lights == int(n) && built->num_nodes() > 0)
+      d.tree = std::move(*built);
+    else
+      d.tree = build_light_tree(lights);
     d.tree.set_orientation_term(orientation_term);
     d.tree_build_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

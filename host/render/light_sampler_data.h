@@ -44,10 +44,13 @@ struct LightSamplerData {
   LightSamplerCtx host_view(const std::vector<Light>& lights, float2* brdf_cut = nullptr) const;
 };
 
-// Throws SceneError for an unknown sampler name.
+// Throws SceneError for an unknown sampler name. `built`: a light tree already built for `lights`
+// (it depends on them alone), moved from if this sampler needs one instead of building it again
+// (Renderer::set_light_sampler, when the auto pilot goes from one tree sampler to another).
 LightSamplerData make_light_sampler_data(const std::vector<Light>& lights, const std::string& name,
                                          float split_threshold, int max_cut,
                                          bool orientation_term = true,
-                                         const BrdfSettings& brdf = BrdfSettings());
+                                         const BrdfSettings& brdf = BrdfSettings(),
+                                         LightTree* built = nullptr);
 
 } // namespace canopy

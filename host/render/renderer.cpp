@@ -189,12 +189,23 @@ void Renderer::compile_kernels() {
   stats_.compile_seconds = seconds_since(t0);
 }
 
+cl::Buffer Renderer::scratch_buffer(const std::string& name, size_t bytes) {
+  ScratchBuffer& b = buffers_[name];
+  if (b.bytes < bytes || !b.buffer()) {
+    b.buffer = cl::Buffer(); // free the smaller one first
+    b.buffer = device_buffer(rt_.context(), bytes);
+    b.bytes = bytes;
+  }
+  return b.buffer;
+}
+
 void Renderer::set_film_size(int width, int height) {
   if (width < 1 || height < 1)
     throw std::invalid_argument(
         fmt::format("film size {}x{}: must be at least 1x1", width, height));
   film_w_ = width;
   film_h_ = height;
+  release_buffers();
   std::vector<CameraParams> cam = {make_camera_params(scene_.camera, width, height)};
   camera_ = upload_buffer(rt_.context(), cam);
 }
@@ -215,8 +226,11 @@ void Renderer::set_light_sampler(const RendererOptions& options) {
   auto t0 = Clock::now();
   // The geometry, textures and the rest stay; only the sampler's data and the kernels change.
   options_ = options;
-  sampler_ = make_light_sampler_data(scene_.lights, options.light_sampler, options.split_threshold,
-                                     options.max_cut, options.orientation_term, options.brdf);
+  release_buffers(); // sized for the previous sampler
+  LightTree previous = std::move(sampler_.tree);
+  sampler_ =
+      make_light_sampler_data(scene_.lights, options.light_sampler, options.split_threshold,
+                              options.max_cut, options.orientation_term, options.brdf, &previous);
   stats_.light_tree_seconds = sampler_.tree_build_seconds;
   stats_.build_seconds = seconds_since(t0);
   t0 = Clock::now();
@@ -228,7 +242,6 @@ void Renderer::set_light_sampler(const RendererOptions& options) {
 
 Film Renderer::render(const RenderSettings& settings) {
   auto t_start = Clock::now();
-  const cl::Context& ctx = rt_.context();
   cl::CommandQueue& q = rt_.queue();
   // The window of the film and the sample range rendered (generate.cl).
   const int film_w = film_w_, film_h = film_h_;
@@ -280,7 +293,7 @@ Film Renderer::render(const RenderSettings& settings) {
   // launch and never stored here, so a launch cannot pick up a stale one.
   KernelArgs args;
   auto buffer = [&](const char* name, size_t bytes) {
-    cl::Buffer b = device_buffer(ctx, bytes);
+    cl::Buffer b = scratch_buffer(name, bytes);
     args.set(name, b);
     return b;
   };
@@ -298,11 +311,11 @@ Film Renderer::render(const RenderSettings& settings) {
   PATH_STATE_BUFFERS(CANOPY_PATH_BUFFER)
 #undef CANOPY_PATH_BUFFER
   cl::Buffer queue_a = buffer("ray_queue", W * sizeof(cl_int)); // generate's output
-  cl::Buffer queue_b = device_buffer(ctx, W * sizeof(cl_int));
+  cl::Buffer queue_b = scratch_buffer("ray_queue_out", W * sizeof(cl_int));
   cl::Buffer counts_shade = buffer("counts_shade", W * sizeof(cl_int2));
   cl::Buffer cut_size = buffer("cut_size", W * sizeof(cl_int));
-  cl::Buffer split_a = device_buffer(ctx, split_cap * sizeof(SplitItem));
-  cl::Buffer split_b = device_buffer(ctx, split_cap * sizeof(SplitItem));
+  cl::Buffer split_a = scratch_buffer("split_a", split_cap * sizeof(SplitItem));
+  cl::Buffer split_b = scratch_buffer("split_b", split_cap * sizeof(SplitItem));
   buffer("child_stage", 4 * split_cap * sizeof(SplitItem));
   buffer("shadow_stage", shadow_slots * split_cap * sizeof(ShadowItem));
   // A pass's shadow queue: at most one item per light in the cuts (at most split_cap of them).
