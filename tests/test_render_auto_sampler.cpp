@@ -152,3 +152,23 @@ TEST(AutoSampler, ASwitchedRendererRendersAsAFreshOne) {
   Renderer fresh_tree(rt, scene, tree);
   expect_same(b, fresh_tree.render(rs), "-> power -> tree");
 }
+
+// The pilot times renders of one full wave; a wave's paths are bounded by the split queue for a
+// splitting sampler (every path's cut must fit: split_queue_items / max_cut) and by the settings'
+// wave size otherwise.
+TEST(AutoSampler, AWaveHoldsAsManyPathsAsTheSplitQueueAllows) {
+  Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
+  ClRuntime rt;
+  RendererOptions opt;
+  opt.light_sampler = "tree";
+  Renderer renderer(rt, scene, opt);
+  EXPECT_EQ(renderer.paths_per_wave(size_t(1) << 18), size_t(1) << 18);
+  EXPECT_EQ(renderer.paths_per_wave(1000), 1000u);
+  opt.light_sampler = "tree-split";
+  opt.max_cut = 64;
+  renderer.set_light_sampler(opt);
+  EXPECT_EQ(renderer.paths_per_wave(size_t(1) << 18), opt.split_queue_items / 64);
+  opt.max_cut = 2;
+  renderer.set_light_sampler(opt);
+  EXPECT_EQ(renderer.paths_per_wave(size_t(1) << 18), size_t(1) << 18);
+}

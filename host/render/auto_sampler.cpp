@@ -93,11 +93,14 @@ AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base,
   renderer.set_film_size(fw, fh);
   const double npix = double(fw) * double(fh);
   const RenderSettings defaults;
-  const int passes = int(std::clamp(std::ceil(double(defaults.wave_size) / npix), 1.0, 256.0));
   std::vector<PilotStats> stats;
   for (PilotResult& c : out.candidates) {
     if (&c != &out.candidates.front() || !same_sampler(renderer.options(), c.options))
       renderer.set_light_sampler(c.options);
+    // Enough passes to fill one of this sampler's waves (2^18 paths: 4 passes of a 256x256 film;
+    // a splitting sampler's 16,384: 1 pass).
+    const double wave = double(renderer.paths_per_wave(defaults.wave_size));
+    const int passes = int(std::clamp(std::ceil(wave / npix), 1.0, 256.0));
     // Untimed, samples [0, 1): PoCL compiles each kernel on its first launch (or loads it from its
     // cache), and the first render over the film touches the scene's memory for the first time.
     RenderSettings rs;

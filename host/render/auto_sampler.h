@@ -36,16 +36,18 @@ struct AutoChoice {
 // glossy material); each keeps base's other settings.
 std::vector<PilotResult> auto_candidates(const RendererOptions& base);
 
-// The pilot: per candidate, after an untimed warm-up, a timed render of the film itself with
-// enough passes to fill one wave (2^18 paths: 4 passes of a 256x256 film, 1 of a larger one), and
-// a second one if the first took less than 0.25 s. The faster gives the time per pass (robust to a
-// moment of other load on the machine); each pixel's sample variance over both, averaged over the
-// pixels whose camera rays saw no emitter (their noise is the emitter's edge, the same for every
-// sampler), gives the variance per sample. A candidate whose image mean is more than 4 standard
-// errors below the median candidate's has missed rare large samples (its measured variance is then
-// far too low) and is not ranked. Leaves `renderer` set to the winner, at the scene's film size,
-// its render statistics zeroed. The choice depends on timings, so it can differ between runs where
-// two candidates are close; every candidate is unbiased, so only the noise can change.
+// The pilot: per candidate, after an untimed pass over the film, two timed renders of the film
+// itself, each with enough passes to fill one of the sampler's waves (Renderer::paths_per_wave:
+// 4 passes of a 256x256 film for power and tree, 1 for a splitting sampler or a film of 2^18
+// pixels). The faster gives the time per pass (robust to a moment of other load on the machine, and
+// to the first one allocating the wave's buffers); each pixel's sample variance over all three,
+// averaged over the pixels whose camera rays saw no emitter (their noise is the emitter's edge, the
+// same for every sampler), gives the variance per sample. A candidate whose image mean is more than
+// 4 standard errors below the median candidate's has missed rare large samples (its measured
+// variance is then far too low) and is not ranked. Leaves `renderer` set to the winner, at the
+// scene's film size, its render statistics zeroed. The choice depends on timings, so it can differ
+// between runs where two candidates are close; every candidate is unbiased, so only the noise can
+// change.
 AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base, uint32_t seed);
 
 // One line for logs: "auto: tree (pilot 0.84 s; efficiency power 12.3 (0.05 s/pass), tree 45.6

@@ -189,6 +189,22 @@ void Renderer::compile_kernels() {
   stats_.compile_seconds = seconds_since(t0);
 }
 
+size_t Renderer::max_cut_items() const {
+  // A cut never holds more items in a pass than its budget, nor more than max_cut (every light, for
+  // the exhaustive sampler): a shading point's cut at most max_cut and, with a medium, its
+  // segment's at most the segment budget (light_sampler_segment_budget).
+  const size_t segment_items =
+      std::min<size_t>(sampler_.max_cut, light_sampler_segment_budget(sampler_.root_budget()));
+  // A shading point's distant lights (light_pick.h) come on top of its cut.
+  return size_t(sampler_.max_cut) + (volume_stages_ ? segment_items : 0u) +
+         scene_.infinite_lights.size();
+}
+
+size_t Renderer::paths_per_wave(size_t wave_size) const {
+  // Waves of split_queue_items / max_cut_items() paths bound the split queue.
+  return std::max<size_t>(1, std::min(wave_size, options_.split_queue_items / max_cut_items()));
+}
+
 cl::Buffer Renderer::scratch_buffer(const std::string& name, size_t bytes) {
   ScratchBuffer& b = buffers_[name];
   if (b.bytes < bytes || !b.buffer()) {
@@ -259,20 +275,10 @@ Film Renderer::render(const RenderSettings& settings) {
   const int width = win.width(), height = win.height();
   const int npix = width * height;
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
-  // A cut never holds more items in a pass than its budget, nor more than max_cut (every light, for
-  // the exhaustive sampler): a shading point's cut at most max_cut and, with a medium, its
-  // segment's at most the segment budget (light_sampler_segment_budget). Waves of
-  // split_queue_items / (both bounds) paths bound the split queue.
   const bool medium = volume_stages_;
   const size_t shadow_slots = LIGHT_PICK_SHADOW_SLOTS;
-  const size_t segment_items =
-      std::min<size_t>(sampler_.max_cut, light_sampler_segment_budget(sampler_.root_budget()));
-  // A shading point's distant lights (light_pick.h) come on top of its cut.
-  const size_t cut_items =
-      size_t(sampler_.max_cut) + (medium ? segment_items : 0u) + scene_.infinite_lights.size();
-  size_t wave =
-      std::max<size_t>(1, std::min(settings.wave_size, options_.split_queue_items / cut_items));
-  const size_t W = size_t(std::min<uint64_t>(total, wave));
+  const size_t cut_items = max_cut_items();
+  const size_t W = size_t(std::min<uint64_t>(total, paths_per_wave(settings.wave_size)));
   const size_t split_cap = W * cut_items;
   const int max_depth = scene_.integrator.max_depth;
   // Fail before any work if the film or the wave does not fit (docs/limits.md).

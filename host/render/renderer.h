@@ -155,6 +155,10 @@ public:
   // Zeroes what render() accumulates (time, counts, stage timings, histogram), keeping the build,
   // upload and compile figures: the auto sampler's pilot renders are not the render's.
   void reset_render_stats();
+  // The paths a wave of render() holds for this sampler with RenderSettings::wave_size
+  // `wave_size`, before the render's own size bounds it: fewer for a splitting sampler, whose wave
+  // must fit its cuts in the split queue (RendererOptions::split_queue_items).
+  size_t paths_per_wave(size_t wave_size) const;
   // Frees the device buffers that render() keeps for the next render (set_light_sampler and
   // set_film_size do too).
   void release_buffers() { buffers_.clear(); }
@@ -167,6 +171,9 @@ private:
   // `canopy converge`'s seeds) the first-touch page faults of ~100-500 MB of fresh buffers, which
   // cost 5-15% of a one-wave render on PoCL's CPU device.
   cl::Buffer scratch_buffer(const std::string& name, size_t bytes);
+  // The most split-queue items a path holds in one split pass (its cut, a medium segment's cut,
+  // the distant lights).
+  size_t max_cut_items() const;
 
   ClRuntime& rt_;
   Scene& scene_;
