@@ -20,7 +20,8 @@ declare -A BEST=(
   [cornell-1m-d1]=tree [cornell-1m-dfull]=power [plane-10k-dfull]=tree-split
   [spiral-10k-d1]=tree-split:0.25 [spiral-10k-dfull]=tree-split:0.25 [city-d1]=tree-split:0.25
   [city-dfull]=brdf-mis/split=0.25 [mesh-light-dfull]=tree [spiral-fog-d1]=brdf-mis/split=0.25
-  [spiral-fog-dfull]=tree [city-fog-d1]=tree-split:0.25 [city-fog-dfull]=tree-split:0.25)
+  [spiral-fog-dfull]=tree [city-fog-d1]=tree-split:0.25 [city-fog-dfull]=tree-split:0.25
+  [outdoor-d1]=tree [outdoor-dfull]=power)
 for t in ${TABLES:-$(printf '%s\n' "${!BEST[@]}" | sort)}; do
   # The table's own command (docs/results/<table>-commands.txt) with its reference, other samplers.
   cmd=$(head -1 "docs/results/$t-commands.txt" |

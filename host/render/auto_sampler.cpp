@@ -90,7 +90,6 @@ AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base,
   // (docs/design.md, "Choosing the estimator per scene"). Each timed render holds at least one
   // full wave of paths, as the render's passes do.
   const int fw = renderer.scene().film.width, fh = renderer.scene().film.height;
-  renderer.set_film_size(fw, fh);
   const double npix = double(fw) * double(fh);
   const RenderSettings defaults;
   std::vector<PilotStats> stats;

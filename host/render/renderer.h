@@ -148,10 +148,6 @@ public:
   // split_queue_items as before): rebuilds its data and the kernels, keeps the geometry, textures
   // and environment maps (render/auto_sampler.h tries several this way).
   void set_light_sampler(const RendererOptions& options);
-  // Renders a film of width x height pixels from now on (the scene's camera, the same field of
-  // view): the auto sampler's pilot runs at a reduced resolution. The scene's film size is the
-  // initial one.
-  void set_film_size(int width, int height);
   // Zeroes what render() accumulates (time, counts, stage timings, histogram), keeping the build,
   // upload and compile figures: the auto sampler's pilot renders are not the render's.
   void reset_render_stats();
@@ -159,12 +155,14 @@ public:
   // `wave_size`, before the render's own size bounds it: fewer for a splitting sampler, whose wave
   // must fit its cuts in the split queue (RendererOptions::split_queue_items).
   size_t paths_per_wave(size_t wave_size) const;
-  // Frees the device buffers that render() keeps for the next render (set_light_sampler and
-  // set_film_size do too).
+  // Frees the device buffers that render() keeps for the next render (set_light_sampler does
+  // too).
   void release_buffers() { buffers_.clear(); }
 
 private:
   void compile_kernels(); // for options_ and sampler_: sets program_, brdf_stages_, volume_stages_
+  // The film's size in pixels (the scene's camera and field of view); frees the kept buffers.
+  void set_film_size(int width, int height);
   // A device buffer of at least `bytes` under `name`: the one of an earlier render when it is large
   // enough, else a new one. A render's buffers (path state, queues, film) are written before they
   // are read, so they can be reused; reusing them spares a repeated render (the auto pilot,
