@@ -221,7 +221,6 @@ void Renderer::set_film_size(int width, int height) {
         fmt::format("film size {}x{}: must be at least 1x1", width, height));
   film_w_ = width;
   film_h_ = height;
-  release_buffers();
   std::vector<CameraParams> cam = {make_camera_params(scene_.camera, width, height)};
   camera_ = upload_buffer(rt_.context(), cam);
 }

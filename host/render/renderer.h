@@ -161,7 +161,7 @@ public:
 
 private:
   void compile_kernels(); // for options_ and sampler_: sets program_, brdf_stages_, volume_stages_
-  // The film's size in pixels (the scene's camera and field of view); frees the kept buffers.
+  // The film's size in pixels (the scene's camera and field of view); set once, by the constructor.
   void set_film_size(int width, int height);
   // A device buffer of at least `bytes` under `name`: the one of an earlier render when it is large
   // enough, else a new one. A render's buffers (path state, queues, film) are written before they
