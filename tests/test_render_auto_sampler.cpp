@@ -1,11 +1,13 @@
-// The "auto" light sampler (render/auto_sampler.h): the pilot renders every candidate, ranks them
-// by 1 / (variance per sample x seconds), and leaves the renderer set to the winner.
+// The "auto" light sampler (render/auto_sampler.h): the exploration renders every candidate, ranks
+// them by 1 / (variance per sample x seconds), weights their samples into the image without bias,
+// and leaves the renderer set to the chosen one.
 #include "render/auto_sampler.h"
 #include "scene/scene.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 using namespace canopy;
 
@@ -40,40 +42,198 @@ TEST(AutoSampler, CandidatesArePowerTreeAndTheSplitBrdfMis) {
     EXPECT_EQ(p.options.max_cut, 32); // the rest of base is kept
 }
 
-// Power sampling is hopeless here: the pilot must see it, and the renderer must end on the winner,
-// the candidate with the highest measured efficiency.
-TEST(AutoSampler, ThePilotRanksByEfficiencyAndLeavesTheWinnerSet) {
+// The exploration takes at most 60% of the samples and leaves one for the chosen candidate; its
+// timed renders fill a wave when there is room, and shrink (to one render, then none) when not.
+TEST(AutoSampler, TheExplorationFitsTheSampleBudget) {
+  const std::vector<int> waves = {4, 4, 1};
+  for (int spp = 1; spp <= 256; ++spp) {
+    int renders = -1;
+    std::vector<int> p = plan_exploration(spp, waves, &renders);
+    if (p.empty()) {
+      EXPECT_EQ(renders, 0);
+      continue;
+    }
+    ASSERT_EQ(p.size(), waves.size());
+    int explored = int(waves.size());
+    for (size_t c = 0; c < p.size(); ++c) {
+      EXPECT_GE(p[c], 1);
+      EXPECT_LE(p[c], waves[c]);
+      explored += renders * p[c];
+    }
+    EXPECT_LE(explored, int(0.6 * spp)) << spp;
+    EXPECT_LT(explored, spp) << spp;
+    if (spp >= 64) { // room for all: a full wave each, timed twice
+      EXPECT_EQ(renders, 2);
+      EXPECT_EQ(p, waves);
+    }
+  }
+  int renders = 0;
+  EXPECT_TRUE(plan_exploration(9, waves, &renders).empty()); // 3 + 3 > 0.6 x 9
+  EXPECT_FALSE(plan_exploration(10, waves, &renders).empty());
+  EXPECT_EQ(renders, 1);
+}
+
+// Inverse-variance weights relative to the least variance, capped at 1; a candidate that missed
+// its tail weighs nothing and does not set the reference.
+TEST(AutoSampler, ExplorationWeightsAreInverseVarianceAndDropAMissedTail) {
+  std::vector<ExploreStats> s(3);
+  s[0].variance = 1e-4; // low only because it missed its tail: its mean is far too low
+  s[0].mean = 0.5;
+  s[0].mean_variance = 1e-6;
+  s[1].variance = 2.0;
+  s[1].mean = 1.0;
+  s[1].mean_variance = 1e-6;
+  s[2].variance = 8.0;
+  s[2].mean = 1.001;
+  s[2].mean_variance = 1e-6;
+  std::vector<double> w = exploration_weights(s);
+  EXPECT_EQ(w[0], 0.0);
+  EXPECT_EQ(w[1], 1.0);
+  EXPECT_DOUBLE_EQ(w[2], 0.25);
+}
+
+// The most efficient is chosen; a heavier-tailed leader whose interval overlaps another's gives way
+// to the lighter tail; a leader whose interval is clear of the rest stays.
+TEST(AutoSampler, TheChoiceIsTheMostEfficientUnlessALighterTailOverlaps) {
+  auto candidate = [](const char* label, double v, double lo, double hi, double tail, double t) {
+    PilotResult p;
+    p.label = label;
+    p.stats.variance = v;
+    p.stats.variance_lo = lo;
+    p.stats.variance_hi = hi;
+    p.stats.tail_share = tail;
+    p.stats.mean = 1.0;
+    p.stats.mean_variance = 1e-6;
+    p.pass_seconds = t;
+    return p;
+  };
+  std::string reason;
+  std::vector<PilotResult> c = {candidate("a", 1.0, 0.9, 1.1, 0.01, 1.0),
+                                candidate("b", 1.0, 0.95, 1.05, 0.01, 0.5),
+                                candidate("c", 4.0, 3.5, 4.5, 0.01, 0.5)};
+  EXPECT_EQ(choose_candidate(c, &reason), 1u);
+  EXPECT_DOUBLE_EQ(c[1].efficiency, 2.0);
+  EXPECT_DOUBLE_EQ(c[1].efficiency_lo, 1.0 / (1.05 * 0.5));
+  // b's variance is mostly a few pixels and its interval reaches a's: a is taken.
+  c[1].stats.variance_lo = 0.3;
+  c[1].stats.variance_hi = 3.0;
+  c[1].stats.tail_share = 0.6;
+  EXPECT_EQ(choose_candidate(c, &reason), 0u);
+  EXPECT_NE(reason.find("lighter tail"), std::string::npos);
+  // Without the overlap the leader stays, whatever its tail.
+  c[1].stats.variance_lo = 0.9;
+  c[1].stats.variance_hi = 1.1;
+  EXPECT_EQ(choose_candidate(c, &reason), 1u);
+}
+
+// Power sampling is hopeless here: the exploration must see it, its samples must weigh little,
+// every pixel gets exactly spp samples, and the renderer ends on the chosen candidate.
+TEST(AutoSampler, TheExplorationRanksByEfficiencyAndItsSamplesArePartOfTheImage) {
   Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
   ClRuntime rt;
   RendererOptions base = auto_candidates(RendererOptions{}).front().options;
   Renderer renderer(rt, scene, base);
-  AutoChoice choice = choose_light_sampler(renderer, base, 7);
+  RenderSettings rs;
+  rs.spp = 32;
+  rs.seed = 7;
+  AutoRender r = render_auto(renderer, base, rs);
+  const AutoChoice& choice = r.choice;
   ASSERT_EQ(choice.candidates.size(), 3u);
+  int explored = 0;
   for (const PilotResult& c : choice.candidates) {
-    EXPECT_GT(c.variance, 0.0) << c.label;
-    EXPECT_GT(c.seconds, 0.0) << c.label;
-    // the efficiency is that of a pass over the whole film
+    EXPECT_GT(c.stats.variance, 0.0) << c.label;
     EXPECT_GT(c.pass_seconds, 0.0) << c.label;
-    EXPECT_DOUBLE_EQ(c.efficiency, 1.0 / (c.variance * c.pass_seconds)) << c.label;
-    EXPECT_LE(c.efficiency, choice.chosen.efficiency) << c.label;
+    EXPECT_DOUBLE_EQ(c.efficiency, 1.0 / (c.stats.variance * c.pass_seconds)) << c.label;
+    EXPECT_LE(c.efficiency_lo, c.efficiency) << c.label;
+    EXPECT_GE(c.efficiency_hi, c.efficiency) << c.label;
+    EXPECT_EQ(c.first_sample, explored) << c.label; // disjoint sample ranges, in order
+    explored += c.samples;
   }
-  // per-sample variance: power's is far above the tree's (the same order of time per sample)
-  EXPECT_GT(choice.candidates[0].variance, 10.0 * choice.candidates[1].variance);
+  EXPECT_EQ(choice.explored_samples, explored);
+  EXPECT_LT(explored, rs.spp);
+  // per-sample variance: power's is far above the tree's, so its samples weigh little
+  EXPECT_GT(choice.candidates[0].stats.variance, 10.0 * choice.candidates[1].stats.variance);
+  for (int h = 0; h < 2; ++h)
+    EXPECT_LT(choice.candidates[0].weight[h], 0.1);
   EXPECT_NE(choice.chosen.label, "power");
   EXPECT_EQ(renderer.options().light_sampler, choice.chosen.options.light_sampler);
   EXPECT_EQ(renderer.options().split_threshold, choice.chosen.options.split_threshold);
-  EXPECT_GE(choice.pilot_seconds, choice.candidates[0].seconds);
   EXPECT_NE(describe(choice).find("auto: " + choice.chosen.label), std::string::npos);
-  // The pilot's renders are not the render's: its statistics start from zero.
-  EXPECT_EQ(renderer.stats().samples, 0u);
-  EXPECT_EQ(renderer.stats().render_seconds, 0.0);
-  // The renderer renders with it afterwards.
-  RenderSettings rs;
-  rs.spp = 2;
-  Film film = renderer.render(rs);
-  EXPECT_EQ(renderer.stats().samples, uint64_t(2 * 64 * 48));
+  // Every sample index was rendered once: the statistics count the whole image.
+  EXPECT_EQ(renderer.stats().samples, uint64_t(rs.spp) * 64 * 48);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
-  EXPECT_EQ(film.sum.size(), size_t(64 * 48));
+  ASSERT_EQ(r.film.sum.size(), size_t(64 * 48));
+  for (const double4& s : r.film.sum)
+    ASSERT_EQ(s.w, double(rs.spp));
+}
+
+// The image made of the candidates' weighted exploration passes and the chosen one's samples is
+// unbiased: over 8 seeds its image mean equals the exhaustive estimator's (point lights: its only
+// noise is the pixel filter's) within 5 standard errors of the difference.
+TEST(AutoSampler, TheCombinedImageIsUnbiased) {
+  Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
+  ClRuntime rt;
+  auto image_mean = [](const Film& f) {
+    double m = 0.0;
+    for (const double4& s : f.sum)
+      m += (s.x + s.y + s.z) / (3.0 * s.w);
+    return m / double(f.sum.size());
+  };
+  RendererOptions exhaustive;
+  exhaustive.light_sampler = "exhaustive";
+  Renderer ref(rt, scene, exhaustive);
+  RenderSettings rs;
+  rs.spp = 64;
+  rs.seed = 99;
+  Film e = ref.render(rs);
+  // The exhaustive image mean's variance from its per-pixel sample variances.
+  double ref_var = 0.0;
+  for (size_t p = 0; p < e.sum.size(); ++p) {
+    const double k = e.sum[p].w;
+    const double s = (e.sum[p].x + e.sum[p].y + e.sum[p].z) / 3.0;
+    const double q = (e.sumsq[p].x + e.sumsq[p].y + e.sumsq[p].z) / 3.0;
+    ref_var += std::max(0.0, (q - s * s / k) / (k - 1.0)) / k;
+  }
+  ref_var /= double(e.sum.size()) * double(e.sum.size());
+
+  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
+  Renderer renderer(rt, scene, base);
+  std::vector<double> means;
+  for (uint32_t seed = 1; seed <= 8; ++seed) {
+    rs.spp = 24;
+    rs.seed = seed;
+    AutoRender r = render_auto(renderer, base, rs);
+    ASSERT_FALSE(r.choice.candidates.empty());
+    means.push_back(image_mean(r.film));
+  }
+  double m = 0.0, v = 0.0;
+  for (double x : means)
+    m += x / double(means.size());
+  for (double x : means)
+    v += (x - m) * (x - m) / double(means.size() - 1);
+  const double se = std::sqrt(v / double(means.size()) + ref_var);
+  EXPECT_LE(std::fabs(m - image_mean(e)), 5.0 * se)
+      << "auto " << m << " exhaustive " << image_mean(e) << " se " << se;
+  EXPECT_GT(se, 0.0);
+}
+
+// Too few samples to explore: the last candidate renders it all, as a partial render would.
+TEST(AutoSampler, WithoutRoomToExploreTheLastCandidateRenders) {
+  Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
+  ClRuntime rt;
+  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
+  Renderer renderer(rt, scene, base);
+  RenderSettings rs;
+  rs.spp = 4;
+  rs.seed = 3;
+  AutoRender r = render_auto(renderer, base, rs);
+  EXPECT_TRUE(r.choice.candidates.empty());
+  EXPECT_EQ(r.choice.chosen.label, auto_candidates(base).back().label);
+  RendererOptions last = auto_candidates(base).back().options;
+  Renderer fresh(rt, scene, last);
+  Film f = fresh.render(rs);
+  for (size_t p = 0; p < f.sum.size(); ++p)
+    ASSERT_EQ(f.sum[p].x, r.film.sum[p].x) << p;
 }
 
 // Without emitters every candidate's image is black (variance 0): the fastest is taken, and
@@ -85,19 +245,27 @@ TEST(AutoSampler, ABlackScenePicksTheFastest) {
   ClRuntime rt;
   RendererOptions base = auto_candidates(RendererOptions{}).front().options;
   Renderer renderer(rt, scene, base);
-  AutoChoice choice = choose_light_sampler(renderer, base, 7);
+  RenderSettings rs;
+  rs.spp = 16;
+  rs.seed = 7;
+  AutoRender r = render_auto(renderer, base, rs);
+  const AutoChoice& choice = r.choice;
+  ASSERT_EQ(choice.candidates.size(), 3u);
   double fastest = 1e300;
   for (const PilotResult& c : choice.candidates) {
     EXPECT_EQ(c.efficiency, 0.0);
-    fastest = std::min(fastest, c.seconds);
+    fastest = std::min(fastest, c.pass_seconds);
   }
-  EXPECT_EQ(choice.chosen.seconds, fastest);
+  EXPECT_EQ(choice.chosen.pass_seconds, fastest);
+  for (const double4& s : r.film.sum)
+    ASSERT_TRUE(s.x == 0.0 && std::isfinite(s.w));
 }
 
 // One dim light close over the floor outshines 65,536 distant ones there, but holds 6e-9 of the
-// power: power sampling picks it about never in a pilot of at most ~5·10^5 samples, so its image
-// mean falls far below the others' and its measured variance means nothing. It is not ranked.
-TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRanked) {
+// power: power sampling picks it about never in an exploration of ~10^4 samples, so its image
+// mean falls far below the others' and its measured variance means nothing. It is not ranked, and
+// its samples weigh nothing.
+TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRankedNorWeighted) {
   const char* json = R"({
     "camera": { "position": [0, 3, 3], "look_at": [0, 0, 0], "fov": 50 },
     "film": { "width": 64, "height": 48 },
@@ -112,16 +280,21 @@ TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRanked) {
   ClRuntime rt;
   RendererOptions base = auto_candidates(RendererOptions{}).front().options;
   Renderer renderer(rt, scene, base);
-  AutoChoice choice = choose_light_sampler(renderer, base, 11);
+  RenderSettings rs;
+  rs.spp = 32;
+  rs.seed = 11;
+  AutoChoice choice = render_auto(renderer, base, rs).choice;
   EXPECT_TRUE(choice.candidates[0].missed_tail) << describe(choice);
   EXPECT_FALSE(choice.candidates[1].missed_tail) << describe(choice);
   EXPECT_NE(choice.chosen.label, "power");
   EXPECT_NE(describe(choice).find("missed its tail"), std::string::npos);
+  EXPECT_EQ(choice.candidates[0].weight[0], 0.0);
+  EXPECT_EQ(choice.candidates[0].weight[1], 0.0);
 }
 
-// The pilot switches samplers on one renderer, and a tree sampler after another keeps the light
-// tree (it depends on the lights alone): the image after each switch must be the very image of a
-// renderer built for that sampler.
+// The exploration switches samplers on one renderer, and a tree sampler after another keeps the
+// light tree (it depends on the lights alone): the image after each switch must be the very image
+// of a renderer built for that sampler.
 TEST(AutoSampler, ASwitchedRendererRendersAsAFreshOne) {
   Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
   ClRuntime rt;
@@ -153,8 +326,8 @@ TEST(AutoSampler, ASwitchedRendererRendersAsAFreshOne) {
   expect_same(b, fresh_tree.render(rs), "-> power -> tree");
 }
 
-// The pilot times renders of one full wave; a wave's paths are bounded by the split queue for a
-// splitting sampler (every path's cut must fit: split_queue_items / max_cut) and by the settings'
+// The exploration times renders of one full wave; a wave's paths are bounded by the split queue for
+// a splitting sampler (every path's cut must fit: split_queue_items / max_cut) and by the settings'
 // wave size otherwise.
 TEST(AutoSampler, AWaveHoldsAsManyPathsAsTheSplitQueueAllows) {
   Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");

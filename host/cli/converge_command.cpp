@@ -20,6 +20,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -129,10 +131,12 @@ struct ConfigResult {
   std::vector<MedianPoint> medians; // by spp, increasing
   std::vector<PointStats> points;   // by spp, increasing
   double timing_seconds = 0.0;      // --equal-time: the timing renders that chose the spp
-  // "auto": the configuration its pilot chose (render/auto_sampler.h) and the pilot's seconds,
-  // not counted in the render seconds (like the build and the compile).
+  // "auto": the configurations its explorations chose in the recorded runs (render/auto_sampler.h:
+  // "tree x6, power x2") and their mean seconds. Each run's seconds are the whole auto render's,
+  // its exploration and sampler switches included.
   std::string auto_choice;
   double pilot_seconds = 0.0;
+  std::map<std::string, int> auto_choices;
 };
 
 double seconds_since(Clock::time_point t0) {
@@ -366,16 +370,12 @@ std::vector<PointStats> point_stats(const std::vector<RunRecord>& runs, double f
 // close to affine in spp (a fixed cost per render plus a cost per sample), so a first render at
 // `probe` spp that is short against the target is followed by a second one at about half the
 // target, and the line through both is solved for the target. Returns the seconds spent.
-double spp_for_seconds(Renderer& r, double target, int probe, int max_spp, uint32_t seed,
-                       int* spp_out) {
-  auto time_at = [&](int spp) {
-    double before = r.stats().render_seconds;
-    RenderSettings rs;
-    rs.spp = spp;
-    rs.seed = seed;
-    r.render(rs);
-    return std::max(1e-6, r.stats().render_seconds - before);
-  };
+// One render of `spp` samples with seed `seed`; returns its seconds.
+using TimedRender = std::function<double(int spp, uint32_t seed)>;
+
+double spp_for_seconds(const TimedRender& render, double target, int probe, int max_spp,
+                       uint32_t seed, int* spp_out) {
+  auto time_at = [&](int spp) { return std::max(1e-6, render(spp, seed)); };
   probe = std::clamp(probe, 1, max_spp);
   double t1 = time_at(probe), spent = t1;
   double spp = double(probe) * target / t1;
@@ -488,8 +488,16 @@ void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, P
     r.render(warm);
     progress.show(fmt::format("reference {}: timing renders for {:g} s", c.label, a.reference_time),
                   false);
-    spp_for_seconds(r, a.reference_time, std::max(1, a.spp_start), 1 << 24, 0xC0FFEEu + 1,
-                    &total_spp);
+    spp_for_seconds(
+        [&](int spp, uint32_t seed) {
+          const double before = r.stats().render_seconds;
+          RenderSettings rs;
+          rs.spp = spp;
+          rs.seed = seed;
+          r.render(rs);
+          return r.stats().render_seconds - before;
+        },
+        a.reference_time, std::max(1, a.spp_start), 1 << 24, 0xC0FFEEu + 1, &total_spp);
   }
   const int half_spp = std::max(1, total_spp / 2);
   auto t0 = Clock::now();
@@ -748,6 +756,27 @@ int run_converge(const ConvergeArgs& a) {
   std::vector<std::unique_ptr<Scene>> scenes;
   std::vector<std::unique_ptr<Renderer>> renderers;
   std::vector<int> equal_spp(configs.size(), a.spp_start);
+  std::vector<AutoChoice> last_choice(configs.size());
+  // One render of configuration ci; returns its seconds (auto: the whole render_auto, exploration
+  // and switches included) and its film in `film` if given.
+  auto timed_render = [&](size_t ci, int spp, uint32_t seed, Film* film) {
+    Renderer& renderer = *renderers[ci];
+    RenderSettings rs;
+    rs.spp = spp;
+    rs.seed = seed;
+    if (results[ci].config.sampler == kAutoLightSampler) {
+      const auto t0 = Clock::now();
+      AutoRender r = render_auto(renderer, renderer_options(results[ci].config), rs);
+      const double t = seconds_since(t0);
+      last_choice[ci] = r.choice;
+      if (film) *film = std::move(r.film);
+      return t;
+    }
+    const double before = renderer.stats().render_seconds;
+    Film f = renderer.render(rs);
+    if (film) *film = std::move(f);
+    return renderer.stats().render_seconds - before;
+  };
   for (size_t ci = 0; ci < configs.size(); ++ci) {
     ConfigResult& res = results[ci];
     res.config = configs[ci];
@@ -760,28 +789,20 @@ int run_converge(const ConvergeArgs& a) {
     renderers.push_back(
         std::make_unique<Renderer>(rt, *scenes.back(), renderer_options(res.config)));
     Renderer& renderer = *renderers.back();
-    if (res.config.sampler == kAutoLightSampler) {
-      AutoChoice choice =
-          choose_light_sampler(renderer, renderer_options(res.config), 0xC0FFEEu + 2);
-      res.auto_choice = choice.chosen.label;
-      res.pilot_seconds = choice.pilot_seconds;
-      progress.show(fmt::format("[{}/{}] {}", ci + 1, configs.size(), describe(choice)), true);
-    }
     res.build_seconds = renderer.stats().build_seconds;
     res.light_tree_seconds = renderer.stats().light_tree_seconds;
     res.compile_seconds = renderer.stats().compile_seconds;
     // Warm-up: PoCL compiles the work-group variants of the kernels on their first launch, so
-    // the first render is slow. It is not recorded.
-    RenderSettings rs;
-    rs.spp = a.spp_start;
-    rs.seed = 0xC0FFEEu;
-    renderer.render(rs);
-    res.warmup_seconds = renderer.stats().render_seconds;
+    // the first render is slow. It is not recorded. auto's explores (every candidate's kernels).
+    const bool automatic = res.config.sampler == kAutoLightSampler;
+    const int warm_spp = automatic ? std::max(a.spp_start, 16) : a.spp_start;
+    res.warmup_seconds = timed_render(ci, warm_spp, 0xC0FFEEu, nullptr);
     std::string timing;
     if (equal_time) {
       // Timing renders (not recorded, their own seed): the spp of one render of ~equal_time s.
-      res.timing_seconds = spp_for_seconds(renderer, a.equal_time, a.spp_start, a.max_spp,
-                                           0xC0FFEEu + 1, &equal_spp[ci]);
+      res.timing_seconds = spp_for_seconds(
+          [&](int spp, uint32_t seed) { return timed_render(ci, spp, seed, nullptr); },
+          a.equal_time, a.spp_start, a.max_spp, 0xC0FFEEu + 1, &equal_spp[ci]);
       timing = fmt::format(", timing {:.2f} s: {} spp", res.timing_seconds, equal_spp[ci]);
     }
     progress.show(fmt::format("[{}/{}] {:<16} build {:.3f} s (light tree {:.3f} s), compile "
@@ -797,15 +818,16 @@ int run_converge(const ConvergeArgs& a) {
     Renderer& renderer = *renderers[ci];
     ConfigResult& res = results[ci];
     RenderStats before = renderer.stats();
-    RenderSettings rs;
-    rs.spp = spp;
-    rs.seed = uint32_t(1 + s);
-    Film film = renderer.render(rs);
-    const RenderStats& after = renderer.stats();
+    Film film;
     RunRecord run;
+    run.seconds = timed_render(ci, spp, uint32_t(1 + s), &film);
+    if (res.config.sampler == kAutoLightSampler) {
+      ++res.auto_choices[last_choice[ci].chosen.label];
+      res.pilot_seconds += last_choice[ci].pilot_seconds;
+    }
+    const RenderStats& after = renderer.stats();
     run.spp = spp;
-    run.seed = rs.seed;
-    run.seconds = after.render_seconds - before.render_seconds;
+    run.seed = uint32_t(1 + s);
     run.shadow_rays = after.shadow_rays - before.shadow_rays;
     run.shading_points = after.shading_points - before.shading_points;
     run.glossy_points = after.glossy_points - before.glossy_points;
@@ -876,8 +898,12 @@ int run_converge(const ConvergeArgs& a) {
   }
   renderers.clear();
   scenes.clear();
-  for (ConfigResult& res : results)
+  for (ConfigResult& res : results) {
     res.points = point_stats(res.runs, floor_all, floor_ne);
+    for (const auto& [label, n] : res.auto_choices)
+      res.auto_choice += fmt::format("{}{} x{}", res.auto_choice.empty() ? "" : " ", label, n);
+    if (!res.runs.empty()) res.pilot_seconds /= double(res.runs.size());
+  }
 
   std::string scene_name = fs::path(a.scene).stem().string();
   write_csvs(prefix, scene_name, ref_mse, a.clamp, base.integrator.max_depth, mode, results);

@@ -353,11 +353,11 @@ int run_render(const RenderArgs& args) {
   ropt.brdf.n_max = scene.integrator.brdf_n_max;
   ropt.brdf.lambda = scene.integrator.brdf_lambda;
   ropt.brdf.adaptive = scene.integrator.brdf_adaptive;
-  // "auto": the renderer starts with the first candidate; the pilot leaves it at the winner, which
-  // the summary, the metadata and the stats then name.
-  // A partial render (--samples, --crop) takes the last candidate without a pilot: the pilot's
-  // outcome depends on timings, and the parts of one image must use one sampler to merge into
-  // exactly the single render.
+  // "auto": the renderer starts with the first candidate; the exploration leaves it at the chosen
+  // one, which the summary, the metadata and the stats then name.
+  // A partial render (--samples, --crop) takes the last candidate without exploring: the choice
+  // depends on timings, and a partial render's estimator must be determined by the scene, the seed
+  // and the range, so that parts rendered anywhere merge into exactly the single render.
   bool automatic = scene.integrator.light_sampler == kAutoLightSampler;
   if (automatic && (args.samples || args.crop)) {
     automatic = false;
@@ -366,19 +366,12 @@ int run_render(const RenderArgs& args) {
     scene.integrator.split_threshold = ropt.split_threshold;
   }
   if (automatic) {
-    // A film that cannot fit fails now, not after the pilot.
+    // A film that cannot fit fails now, not after the exploration.
     check_film_memory(rt.device(), uint64_t(scene.film.width) * uint64_t(scene.film.height),
                       scene.path.string());
     ropt = auto_candidates(ropt).front().options;
   }
   Renderer renderer(rt, scene, ropt);
-  std::optional<AutoChoice> choice;
-  if (automatic) {
-    choice = choose_light_sampler(renderer, ropt, scene.integrator.seed ^ 0x9E3779B9u);
-    scene.integrator.light_sampler = choice->chosen.options.light_sampler;
-    scene.integrator.split_threshold = choice->chosen.options.split_threshold;
-    if (!args.quiet) std::fprintf(stderr, "canopy: %s\n", describe(*choice).c_str());
-  }
   Progress progress(args.quiet);
   RenderSettings settings;
   settings.spp = scene.integrator.spp;
@@ -386,8 +379,20 @@ int run_render(const RenderArgs& args) {
   settings.first_sample = first_sample;
   settings.window = window;
   settings.progress = [&progress](double f) { progress.update(f); };
-  Film film = renderer.render(settings);
+  std::optional<AutoChoice> choice;
+  Film film;
+  if (automatic) {
+    // The exploration's samples are part of the image (render/auto_sampler.h).
+    AutoRender a = render_auto(renderer, ropt, settings);
+    film = std::move(a.film);
+    choice = std::move(a.choice);
+    scene.integrator.light_sampler = choice->chosen.options.light_sampler;
+    scene.integrator.split_threshold = choice->chosen.options.split_threshold;
+  } else {
+    film = renderer.render(settings);
+  }
   progress.finish();
+  if (choice && !args.quiet) std::fprintf(stderr, "canopy: %s\n", describe(*choice).c_str());
 
   RgbImage img = film.mean();
   if (scene.film.image_scale != 1.0f) // (pbrt's Film scale and iso) FLT_MAX stays finite below
@@ -458,13 +463,22 @@ int run_render(const RenderArgs& args) {
     if (choice) {
       nlohmann::json a;
       a["chosen"] = choice->chosen.label;
+      a["reason"] = choice->reason;
       a["pilot_seconds"] = choice->pilot_seconds;
+      a["explored_samples"] = choice->explored_samples;
       for (const PilotResult& c : choice->candidates)
-        a["candidates"].push_back({{"label", c.label},
-                                   {"variance", c.variance},
-                                   {"seconds", c.seconds},
-                                   {"pass_seconds", c.pass_seconds},
-                                   {"efficiency", c.efficiency}});
+        a["candidates"].push_back(
+            {{"label", c.label},
+             {"samples", c.samples},
+             {"variance", c.stats.variance},
+             {"variance_interval", {c.stats.variance_lo, c.stats.variance_hi}},
+             {"tail_share", c.stats.tail_share},
+             {"seconds", c.seconds},
+             {"pass_seconds", c.pass_seconds},
+             {"efficiency", c.efficiency},
+             {"efficiency_lo", c.efficiency_lo},
+             {"missed_tail", bool(c.missed_tail)},
+             {"weight", {c.weight[0], c.weight[1]}}});
       j["auto"] = a;
     }
     j["split_threshold"] = scene.integrator.split_threshold;

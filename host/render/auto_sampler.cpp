@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <numeric>
 
 namespace canopy {
 
@@ -21,150 +23,326 @@ std::vector<PilotResult> auto_candidates(const RendererOptions& base) {
   return c;
 }
 
+std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, int* renders) {
+  *renders = 0;
+  const int n = int(wave_passes.size());
+  // At most 60% of the samples, and one left for the chosen candidate.
+  const int budget = std::min(spp - 1, int(0.6 * double(spp)));
+  const double want = double(std::accumulate(wave_passes.begin(), wave_passes.end(), 0));
+  for (int r = 2; r >= 1; --r) {
+    // Each candidate: 1 untimed pass + r timed renders of p passes, p scaled down to fit.
+    const double room = double(budget - n) / double(r);
+    if (room < double(n)) continue;
+    const double f = std::min(1.0, room / want);
+    std::vector<int> p(static_cast<size_t>(n));
+    for (int c = 0; c < n; ++c)
+      p[size_t(c)] = std::max(1, int(std::floor(double(wave_passes[size_t(c)]) * f)));
+    if (n + r * std::accumulate(p.begin(), p.end(), 0) > budget) continue;
+    *renders = r;
+    return p;
+  }
+  return {};
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr int kTiles = 8; // per film side: 64 tiles, 32 in each half
 
 bool same_sampler(const RendererOptions& a, const RendererOptions& b) {
   return a.light_sampler == b.light_sampler && a.split_threshold == b.split_threshold &&
          a.max_cut == b.max_cut && a.orientation_term == b.orientation_term && a.mis == b.mis;
 }
 
-// Film `b`'s samples added to `a`'s (the same pixels, disjoint sample ranges).
-void add_samples(Film& a, const Film& b) {
-  auto add = [](double4& x, const double4& y) {
-    x.x += y.x;
-    x.y += y.y;
-    x.z += y.z;
-    x.w += y.w;
-  };
+// Film `b`'s samples added to `a`'s (the same pixels, disjoint sample ranges), `b`'s sums scaled
+// by `w` per pixel (sumsq by w^2) when given.
+void add_samples(Film& a, const Film& b, const std::vector<double>* w = nullptr) {
   for (size_t p = 0; p < a.sum.size(); ++p) {
-    add(a.sum[p], b.sum[p]);
-    add(a.sumsq[p], b.sumsq[p]);
-    add(a.counts[p], b.counts[p]);
+    const double s = w ? (*w)[p] : 1.0;
+    double4 &x = a.sum[p], &q = a.sumsq[p], &c = a.counts[p];
+    const double4 &y = b.sum[p], &r = b.sumsq[p], &d = b.counts[p];
+    x.x += s * y.x, x.y += s * y.y, x.z += s * y.z, x.w += y.w;
+    q.x += s * s * r.x, q.y += s * s * r.y, q.z += s * s * r.z, q.w += r.w;
+    c.x += d.x, c.y += d.y, c.z += d.z, c.w += d.w;
   }
 }
 
-// Over the pixels without an emitter in view (all pixels if each has one): the mean per-sample
-// variance (of the three channels), the image's mean value and that mean's variance.
-struct PilotStats {
-  double variance = 0.0, mean = 0.0, mean_variance = 0.0;
-};
+int tile_of(const Film& f, size_t p) {
+  const int x = int(p % size_t(f.width)), y = int(p / size_t(f.width));
+  return (y * kTiles / f.height) * kTiles + x * kTiles / f.width;
+}
 
-PilotStats pilot_stats(const Film& film) {
-  const std::vector<uint8_t> mask = film.emitter_mask();
-  const bool any_clear = std::count(mask.begin(), mask.end(), uint8_t(0)) > 0;
-  double var = 0.0, mean = 0.0, mean_var = 0.0;
-  size_t n = 0;
-  for (size_t p = 0; p < film.sum.size(); ++p) {
-    if (any_clear && mask[p]) continue;
-    const double k = film.sum[p].w;
-    if (!(k > 1.0)) continue;
-    const double s[3] = {film.sum[p].x, film.sum[p].y, film.sum[p].z};
-    const double q[3] = {film.sumsq[p].x, film.sumsq[p].y, film.sumsq[p].z};
-    double v = 0.0;
-    for (int c = 0; c < 3; ++c)
-      v += std::max(0.0, (q[c] - s[c] * s[c] / k) / (k - 1.0)) / 3.0;
-    var += v;
-    mean += (s[0] + s[1] + s[2]) / (3.0 * k);
-    mean_var += v / k;
-    ++n;
-  }
-  PilotStats st;
-  if (n == 0) return st;
-  st.variance = var / double(n);
-  st.mean = mean / double(n);
-  st.mean_variance = mean_var / (double(n) * double(n));
-  return st;
+// The half (0 or 1) of the film's checkerboard of tiles that pixel p is in.
+int half_of(const Film& f, size_t p) {
+  const int t = tile_of(f, p);
+  return (t / kTiles + t % kTiles) & 1;
 }
 
 } // namespace
 
-AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base, uint32_t seed) {
+ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half) {
+  std::vector<double> tile_sum(kTiles * kTiles, 0.0), tile_n(kTiles * kTiles, 0.0), v;
+  double mean = 0.0, mean_var = 0.0;
+  size_t clear = 0;
+  bool any_clear = false;
+  for (size_t p = 0; p < film.sum.size(); ++p)
+    any_clear = any_clear || ((half < 0 || half_of(film, p) == half) && !emitter[p]);
+  for (size_t p = 0; p < film.sum.size(); ++p) {
+    if (half >= 0 && half_of(film, p) != half) continue;
+    const double k = film.sum[p].w;
+    if (!(k > 1.0)) continue;
+    const double s[3] = {film.sum[p].x, film.sum[p].y, film.sum[p].z};
+    const double q[3] = {film.sumsq[p].x, film.sumsq[p].y, film.sumsq[p].z};
+    double vp = 0.0;
+    for (int c = 0; c < 3; ++c)
+      vp += std::max(0.0, (q[c] - s[c] * s[c] / k) / (k - 1.0)) / 3.0;
+    v.push_back(vp);
+    const int t = tile_of(film, p);
+    tile_sum[size_t(t)] += vp;
+    tile_n[size_t(t)] += 1.0;
+    if (any_clear && emitter[p]) continue;
+    mean += (s[0] + s[1] + s[2]) / (3.0 * k);
+    mean_var += vp / k;
+    ++clear;
+  }
+  ExploreStats st;
+  if (v.empty()) return st;
+  const double total = std::accumulate(v.begin(), v.end(), 0.0);
+  const double n = double(v.size());
+  st.variance = total / n;
+  // The ratio estimate's standard error over the T tiles of the half: the tiles' pixel variances
+  // are not identically distributed, so this is conservative for the mean.
+  double dev = 0.0, tiles = 0.0;
+  for (size_t t = 0; t < tile_sum.size(); ++t) {
+    if (tile_n[t] == 0.0) continue;
+    const double d = tile_sum[t] - st.variance * tile_n[t];
+    dev += d * d;
+    tiles += 1.0;
+  }
+  const double se = tiles > 1.0 ? std::sqrt(tiles / (tiles - 1.0) * dev) / n : 0.0;
+  st.variance_lo = std::max(0.0, st.variance - 1.96 * se);
+  st.variance_hi = st.variance + 1.96 * se;
+  const size_t worst = std::max<size_t>(1, size_t(std::ceil(0.001 * n)));
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(worst - 1), v.end(), std::greater<>());
+  const double top = std::accumulate(v.begin(), v.begin() + std::ptrdiff_t(worst), 0.0);
+  st.tail_share = total > 0.0 ? top / total : 0.0;
+  if (clear > 0) {
+    st.mean = mean / double(clear);
+    st.mean_variance = mean_var / (double(clear) * double(clear));
+  }
+  return st;
+}
+
+namespace {
+
+// Every candidate is unbiased, so their image means agree within their standard errors unless one
+// missed rare large samples (power on a city: a point's near lights are almost never picked): its
+// variance, measured from the samples it drew, is then far too low. Such a candidate has a mean
+// more than 4 standard errors below the median of the candidates'.
+std::vector<bool> missed_tails(const std::vector<ExploreStats>& s) {
+  std::vector<size_t> order(s.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return s[a].mean < s[b].mean; });
+  const size_t med = order[order.size() / 2];
+  std::vector<bool> out(s.size());
+  for (size_t i = 0; i < s.size(); ++i) {
+    const double se = std::sqrt(s[i].mean_variance + s[med].mean_variance);
+    out[i] = se > 0.0 && s[med].mean - s[i].mean > 4.0 * se;
+  }
+  return out;
+}
+
+} // namespace
+
+std::vector<double> exploration_weights(const std::vector<ExploreStats>& other) {
+  const std::vector<bool> missed = missed_tails(other);
+  double vmin = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < other.size(); ++i)
+    if (!missed[i]) vmin = std::min(vmin, other[i].variance);
+  std::vector<double> w(other.size(), 0.0);
+  for (size_t i = 0; i < other.size(); ++i) {
+    if (missed[i]) continue;
+    w[i] = other[i].variance > 0.0 ? std::min(1.0, vmin / other[i].variance) : 1.0;
+  }
+  return w;
+}
+
+size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
+  std::vector<ExploreStats> stats;
+  for (const PilotResult& p : c)
+    stats.push_back(p.stats);
+  const std::vector<bool> missed = missed_tails(stats);
+  for (size_t i = 0; i < c.size(); ++i) {
+    c[i].missed_tail = missed[i];
+    const double t = c[i].pass_seconds, v = c[i].stats.variance;
+    c[i].efficiency = v > 0.0 && t > 0.0 ? 1.0 / (v * t) : 0.0;
+    c[i].efficiency_lo = c[i].stats.variance_hi > 0.0 && t > 0.0
+                             ? 1.0 / (c[i].stats.variance_hi * t)
+                             : c[i].efficiency;
+    c[i].efficiency_hi = c[i].stats.variance_lo > 0.0 && t > 0.0
+                             ? 1.0 / (c[i].stats.variance_lo * t)
+                             : std::numeric_limits<double>::infinity();
+  }
+  auto ranked = [&](size_t i) { return !c[i].missed_tail && c[i].efficiency > 0.0; };
+  size_t best = c.size();
+  for (size_t i = 0; i < c.size(); ++i)
+    if (ranked(i) && (best == c.size() || c[i].efficiency > c[best].efficiency)) best = i;
+  if (best == c.size()) { // nothing measured: the fastest
+    best = 0;
+    for (size_t i = 1; i < c.size(); ++i)
+      if (c[i].pass_seconds < c[best].pass_seconds) best = i;
+    *reason = "no variance measured: the fastest";
+    return best;
+  }
+  *reason = "the most efficient";
+  size_t lighter = c.size();
+  for (size_t i = 0; i < c.size(); ++i) {
+    if (i == best || !ranked(i)) continue;
+    const bool overlap =
+        c[i].efficiency_hi >= c[best].efficiency_lo && c[best].efficiency_hi >= c[i].efficiency_lo;
+    if (overlap && c[i].stats.tail_share <= 0.5 * c[best].stats.tail_share &&
+        (lighter == c.size() || c[i].efficiency > c[lighter].efficiency))
+      lighter = i;
+  }
+  if (lighter != c.size()) {
+    *reason = fmt::format("efficiency within {}'s interval, lighter tail", c[best].label);
+    return lighter;
+  }
+  return best;
+}
+
+AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
+                       const RenderSettings& settings) {
   const auto t0 = Clock::now();
-  AutoChoice out;
-  out.candidates = auto_candidates(base);
-  // The pilot renders the film itself: a pass's cost depends on the film's size (its kernel
-  // launches are shared by all of a wave's paths, and a splitting sampler's waves hold fewer paths
-  // than the others'), which renders at a lower resolution misjudged by 10-20% either way
-  // (docs/design.md, "Choosing the estimator per scene"). Each timed render holds at least one
-  // full wave of paths, as the render's passes do.
+  AutoRender out;
+  AutoChoice& choice = out.choice;
+  std::vector<PilotResult> cand = auto_candidates(base);
   const int fw = renderer.scene().film.width, fh = renderer.scene().film.height;
   const double npix = double(fw) * double(fh);
-  const RenderSettings defaults;
-  std::vector<PilotStats> stats;
-  for (PilotResult& c : out.candidates) {
-    if (&c != &out.candidates.front() || !same_sampler(renderer.options(), c.options))
-      renderer.set_light_sampler(c.options);
-    // Enough passes to fill one of this sampler's waves (2^18 paths: 4 passes of a 256x256 film;
-    // a splitting sampler's 16,384: 1 pass).
-    const double wave = double(renderer.paths_per_wave(defaults.wave_size));
-    const int passes = int(std::clamp(std::ceil(wave / npix), 1.0, 256.0));
-    // Untimed, samples [0, 1): PoCL compiles each kernel on its first launch (or loads it from its
-    // cache), and the first render over the film touches the scene's memory for the first time.
-    RenderSettings rs;
-    rs.seed = seed;
+  std::vector<int> wave_passes;
+  for (const PilotResult& c : cand) {
+    // The passes that fill one of the sampler's waves (2^18 paths: 4 passes of a 256x256 film;
+    // a splitting sampler's about split_queue_items / max_cut, 16,384: 1 pass; the renderer's
+    // paths_per_wave also counts a medium segment's cut and the distant lights). A render of the
+    // film itself, of at least one wave, has the render's own wave structure (docs/design.md,
+    // "Choosing the estimator per scene").
+    const RendererOptions& o = c.options;
+    const bool splits = o.light_sampler != "power" && o.light_sampler != "tree";
+    const double wave = splits ? double(o.split_queue_items) / double(std::max(1, o.max_cut))
+                               : double(settings.wave_size);
+    wave_passes.push_back(int(std::clamp(std::ceil(wave / npix), 1.0, 256.0)));
+  }
+  int renders = 0;
+  const std::vector<int> passes = settings.window.empty()
+                                      ? plan_exploration(settings.spp, wave_passes, &renders)
+                                      : std::vector<int>();
+  RenderSettings rs = settings;
+  rs.progress = nullptr;
+  if (passes.empty()) { // no room to explore: the last candidate, as a partial render takes
+    choice.chosen = cand.back();
+    choice.reason = "too few samples to explore";
+    if (!same_sampler(renderer.options(), choice.chosen.options))
+      renderer.set_light_sampler(choice.chosen.options);
+    out.film = renderer.render(settings);
+    return out;
+  }
+
+  // The exploration: per candidate, one untimed pass (PoCL compiles a kernel at its first launch,
+  // and the first render touches the scene's memory), then `renders` timed renders of its passes.
+  // The faster gives the time per pass (robust to a moment of other load on the machine).
+  int next = settings.first_sample;
+  std::vector<Film> films;
+  for (size_t i = 0; i < cand.size(); ++i) {
+    PilotResult& c = cand[i];
+    if (!same_sampler(renderer.options(), c.options)) renderer.set_light_sampler(c.options);
+    c.first_sample = next;
+    rs.first_sample = next;
+    rs.spp = 1;
     Film film = renderer.render(rs);
-    // Samples [1, 1 + passes) and [1 + passes, 1 + 2 passes), each render timed: the faster gives
-    // the time per pass. The first may allocate the wave's buffers (render() keeps them for the
-    // next), and a pilot timed once, on a machine with other work, misjudged 2x differences.
-    rs.spp = passes;
-    double timed = 0.0, per_pass = 0.0;
-    for (int r = 0; r < 2; ++r) {
-      rs.first_sample = 1 + r * passes;
+    next += 1;
+    rs.spp = passes[i];
+    for (int r = 0; r < renders; ++r) {
+      rs.first_sample = next;
       const auto start = Clock::now();
       Film f = renderer.render(rs);
       const double t = std::chrono::duration<double>(Clock::now() - start).count();
-      per_pass = r == 0 ? t / passes : std::min(per_pass, t / passes);
-      timed += t;
+      c.pass_seconds = r == 0 ? t / passes[i] : std::min(c.pass_seconds, t / passes[i]);
+      c.seconds += t;
       add_samples(film, f);
+      next += passes[i];
     }
-    stats.push_back(pilot_stats(film));
-    c.variance = stats.back().variance;
-    c.seconds = timed;
-    c.pass_seconds = per_pass;
-    c.efficiency = c.variance > 0.0 && per_pass > 0.0 ? 1.0 / (c.variance * per_pass) : 0.0;
+    c.samples = next - c.first_sample;
+    films.push_back(std::move(film));
   }
-  // Every candidate is unbiased, so their image means agree within their standard errors unless
-  // one missed rare large samples (power on a city: the near lights are almost never picked): its
-  // variance, measured from the samples it drew, is then far too low. Such a candidate (mean more
-  // than 4 standard errors below the median of the three) is not ranked.
-  std::vector<double> means;
-  for (const PilotStats& s : stats)
-    means.push_back(s.mean);
-  std::vector<double> sorted = means;
-  std::sort(sorted.begin(), sorted.end());
-  const size_t med =
-      size_t(std::find(means.begin(), means.end(), sorted[sorted.size() / 2]) - means.begin());
-  for (size_t i = 0; i < out.candidates.size(); ++i) {
-    const double se = std::sqrt(stats[i].mean_variance + stats[med].mean_variance);
-    out.candidates[i].missed_tail = means[med] - means[i] > 4.0 * se && se > 0.0;
+  choice.explored_samples = next - settings.first_sample;
+
+  // Measurements over the film and over each half; the emitter mask is the union of every
+  // candidate's (the same pixels for all).
+  std::vector<uint8_t> emitter(films[0].sum.size(), 0);
+  for (const Film& f : films)
+    for (size_t p = 0; p < emitter.size(); ++p)
+      emitter[p] |= f.counts[p].z > 0.0 ? 1 : 0;
+  std::vector<ExploreStats> halves[2];
+  for (size_t i = 0; i < cand.size(); ++i) {
+    cand[i].stats = explore_stats(films[i], emitter, -1);
+    for (int h = 0; h < 2; ++h)
+      halves[h].push_back(explore_stats(films[i], emitter, h));
   }
-  // The most efficient of the ranked; a candidate with no measured variance (a black or
-  // emitter-only pilot) cannot be ranked by it: then the fastest.
-  auto rank = [](const PilotResult& c) { return !c.missed_tail && c.efficiency > 0.0; };
-  const bool ranked = std::any_of(out.candidates.begin(), out.candidates.end(), rank);
-  auto best = out.candidates.end();
-  for (auto it = out.candidates.begin(); it != out.candidates.end(); ++it) {
-    if (ranked && !rank(*it)) continue;
-    if (best == out.candidates.end() ||
-        (ranked ? it->efficiency > best->efficiency : it->seconds < best->seconds))
-      best = it;
+  // Half h's samples are weighted by the other half's measurements.
+  for (int h = 0; h < 2; ++h) {
+    const std::vector<double> w = exploration_weights(halves[1 - h]);
+    for (size_t i = 0; i < cand.size(); ++i)
+      cand[i].weight[h] = w[i];
   }
-  out.chosen = *best;
-  if (best != out.candidates.end() - 1) renderer.set_light_sampler(best->options);
-  renderer.reset_render_stats();
-  out.pilot_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  const size_t best = choose_candidate(cand, &choice.reason);
+  choice.chosen = cand[best];
+  choice.candidates = cand;
+  if (!same_sampler(renderer.options(), cand[best].options))
+    renderer.set_light_sampler(cand[best].options);
+  choice.pilot_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+
+  // The chosen candidate renders the rest; its samples share what is left of each pixel's mass:
+  // (spp - sum of the exploration's weighted samples) / (its samples), at least 1 each.
+  rs = settings;
+  rs.first_sample = next;
+  rs.spp = settings.first_sample + settings.spp - next;
+  Film rest = renderer.render(rs);
+  double explored[2] = {0.0, 0.0};
+  for (int h = 0; h < 2; ++h)
+    for (const PilotResult& c : cand)
+      explored[h] += c.weight[h] * double(c.samples);
+  std::vector<double> w(rest.sum.size());
+  for (size_t p = 0; p < w.size(); ++p)
+    w[p] = (double(settings.spp) - explored[half_of(rest, p)]) / double(rs.spp);
+  out.film = std::move(rest);
+  for (size_t p = 0; p < w.size(); ++p) {
+    double4 &x = out.film.sum[p], &q = out.film.sumsq[p];
+    x.x *= w[p], x.y *= w[p], x.z *= w[p];
+    q.x *= w[p] * w[p], q.y *= w[p] * w[p], q.z *= w[p] * w[p];
+  }
+  for (size_t i = 0; i < cand.size(); ++i) {
+    std::vector<double> wi(w.size());
+    for (size_t p = 0; p < wi.size(); ++p)
+      wi[p] = cand[i].weight[half_of(out.film, p)];
+    add_samples(out.film, films[i], &wi);
+  }
   return out;
 }
 
 std::string describe(const AutoChoice& choice) {
-  std::string s = fmt::format("auto: {} (pilot {:.2f} s; efficiency", choice.chosen.label,
-                              choice.pilot_seconds);
-  for (size_t i = 0; i < choice.candidates.size(); ++i)
-    s += fmt::format("{} {} {:.4g} ({:.3g} s/pass){}", i ? "," : "", choice.candidates[i].label,
-                     choice.candidates[i].efficiency, choice.candidates[i].pass_seconds,
-                     choice.candidates[i].missed_tail ? " (missed its tail: not ranked)" : "");
+  if (choice.candidates.empty())
+    return fmt::format("auto: {} ({})", choice.chosen.label, choice.reason);
+  std::string s =
+      fmt::format("auto: {} ({}; exploration {} spp in {:.2f} s; efficiency", choice.chosen.label,
+                  choice.reason, choice.explored_samples, choice.pilot_seconds);
+  for (size_t i = 0; i < choice.candidates.size(); ++i) {
+    const PilotResult& c = choice.candidates[i];
+    s += fmt::format(
+        "{} {} {:.4g} [{:.3g}, {:.3g}] ({:.3g} s/pass, tail {:.2f}, weight {:.2g}/{:.2g}){}",
+        i ? "," : "", c.label, c.efficiency, c.efficiency_lo, c.efficiency_hi, c.pass_seconds,
+        c.stats.tail_share, c.weight[0], c.weight[1],
+        c.missed_tail ? " (missed its tail: not ranked)" : "");
+  }
   return s + ")";
 }
 

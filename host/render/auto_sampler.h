@@ -1,9 +1,14 @@
-// The "auto" light sampler: a short pilot render of each candidate estimator on the scene, and
-// the one with the highest estimated efficiency, 1 / (variance per sample x seconds per sample),
-// renders. No single estimator is within 10% of the best on every shipped scene
-// (docs/results.md): plain `tree` wins where a point's important lights are few, splitting where
-// they are many, `power` where the tree's pick costs more than it buys. The pilot measures which
-// case a scene is.
+// The "auto" light sampler: the render explores every candidate estimator on the film, then the
+// most efficient one renders the rest, and every sample of the exploration is part of the image.
+// No single estimator is within 10% of the best on every shipped scene (docs/results.md): plain
+// `tree` wins where a point's important lights are few, splitting where they are many, `power`
+// where the tree's pick costs more than it buys. The exploration measures which case a scene is.
+//
+// The image stays exactly unbiased. The film is split into two halves (a checkerboard of tiles);
+// a candidate's exploration samples in one half are weighted by its variance relative to the
+// others' measured on the other half only (independent samples), and the chosen candidate's samples
+// get whatever weight is left of the pixel's unit mass, fixed before they are drawn. A candidate
+// far noisier than the rest (power on a city) then adds almost nothing to the image.
 #pragma once
 
 #include "render/renderer.h"
@@ -13,45 +18,90 @@
 
 namespace canopy {
 
+// A candidate's measurements over a set of pixels (the film, or one half of it).
+struct ExploreStats {
+  // Per sample, over all pixels (emitters in view included: their antialiasing noise is part of
+  // the image the user gets): the mean over pixels and channels of each pixel's sample variance,
+  // and its 95% interval from the spread between tiles (a ratio estimate over tiles).
+  double variance = 0.0, variance_lo = 0.0, variance_hi = 0.0;
+  // The share of the summed pixel variance held by the worst 0.1% of pixels (at least one).
+  double tail_share = 0.0;
+  // Over the pixels whose camera rays saw no emitter: the image's mean value and that mean's
+  // variance (the missed-tail test).
+  double mean = 0.0, mean_variance = 0.0;
+};
+
+// A candidate's measurements from its film: over the pixels of the film's half `half` (0 or 1, a
+// checkerboard of 8 x 8 tiles over the film) or over all (-1). `emitter` marks the pixels whose
+// camera rays saw an emitter (in any candidate's samples).
+ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half);
+
 struct PilotResult {
   std::string label; // the candidate, as `canopy converge` names it (e.g. brdf-mis/split=0.25)
   RendererOptions options;
-  double variance = 0.0;     // per sample: the mean over channels and non-emitter pixels
-  double seconds = 0.0;      // of the pilot renders
-  double pass_seconds = 0.0; // a sample pass over the film, timed in the pilot
-  double efficiency = 0.0;   // 1 / (variance x pass_seconds); 0 if variance is 0
-  // Its pilot image's mean is far below the others': it missed rare large samples, so its
-  // measured variance is too low (see choose_light_sampler). Not ranked.
+  int first_sample = 0, samples = 0; // the sample indices it rendered in the exploration
+  ExploreStats stats;                // over the film
+  double seconds = 0.0;              // of its timed exploration renders
+  double pass_seconds = 0.0;         // a sample pass over the film, timed in the exploration
+  // 1 / (variance x pass_seconds), 0 if the variance is 0, and its interval from the variance's
+  double efficiency = 0.0, efficiency_lo = 0.0, efficiency_hi = 0.0;
+  // Its image mean is far below the others': it missed rare large samples, so its measured
+  // variance is too low. Not ranked, and its samples weigh nothing.
   bool missed_tail = false;
+  // The weight of each of its exploration samples in the two halves of the film (1: as much as a
+  // sample of a render of one sampler; see the file comment).
+  double weight[2] = {0.0, 0.0};
 };
 
 struct AutoChoice {
   PilotResult chosen;
-  std::vector<PilotResult> candidates;
-  double pilot_seconds = 0.0; // everything the choice took: switches, compiles, pilot renders
+  std::vector<PilotResult> candidates; // empty: no exploration (see render_auto)
+  double pilot_seconds = 0.0;          // the exploration: switches, compiles, renders
+  int explored_samples = 0;            // samples per pixel the exploration rendered
+  std::string reason;                  // why this candidate, in a few words
+};
+
+struct AutoRender {
+  Film film;
+  AutoChoice choice;
 };
 
 // The candidates for `base` (whose light sampler is ignored): power, tree, and brdf-mis with
 // splitting at the renderer's default threshold (it renders as tree-split on a scene without a
-// glossy material); each keeps base's other settings.
+// glossy material); each keeps base's other settings. The last is the one taken without
+// exploration.
 std::vector<PilotResult> auto_candidates(const RendererOptions& base);
 
-// The pilot: per candidate, after an untimed pass over the film, two timed renders of the film
-// itself, each with enough passes to fill one of the sampler's waves (Renderer::paths_per_wave:
-// 4 passes of a 256x256 film for power and tree, 1 for a splitting sampler or a film of 2^18
-// pixels). The faster gives the time per pass (robust to a moment of other load on the machine, and
-// to the first one allocating the wave's buffers); each pixel's sample variance over all three,
-// averaged over the pixels whose camera rays saw no emitter (their noise is the emitter's edge, the
-// same for every sampler), gives the variance per sample. A candidate whose image mean is more than
-// 4 standard errors below the median candidate's has missed rare large samples (its measured
-// variance is then far too low) and is not ranked. Leaves `renderer` set to the winner, at the
-// scene's film size, its render statistics zeroed. The choice depends on timings, so it can differ
-// between runs where two candidates are close; every candidate is unbiased, so only the noise can
-// change.
-AutoChoice choose_light_sampler(Renderer& renderer, const RendererOptions& base, uint32_t seed);
+// How many passes each candidate's two timed exploration renders hold, for a render of `spp`
+// samples per pixel: `wave_passes` (one per candidate) fills one of its waves. A candidate renders
+// 1 untimed pass (PoCL compiles a kernel at its first launch) and then up to two timed renders of
+// those passes; the exploration takes at most 60% of the samples and leaves at least one for the
+// chosen candidate. Returns the passes per timed render and sets `renders` (1 or 2); empty when
+// spp is too small to explore (then the last candidate renders everything).
+std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, int* renders);
 
-// One line for logs: "auto: tree (pilot 0.84 s; efficiency power 12.3 (0.05 s/pass), tree 45.6
-// (0.1 s/pass), ...)".
+// The weights of the candidates' samples in one half of the film, from `other`, their
+// measurements over the other half: 0 for a candidate that missed its tail there, else
+// min(1, V_min / V), with V_min the least variance among those that did not. Inverse-variance
+// weights relative to the best, capped at 1 so the remaining samples' weight is at least 1.
+std::vector<double> exploration_weights(const std::vector<ExploreStats>& other);
+
+// Marks the candidates that missed their tail (mean more than 4 standard errors below the median
+// candidate's), then returns the chosen one's index: the most efficient of the rest, unless a
+// candidate whose efficiency interval overlaps its interval has at most half its tail share (the
+// lighter tail is taken: a heavy tail's variance from a few samples is unreliable). Without a
+// measured variance (a black image), the fastest. Sets `reason`.
+size_t choose_candidate(std::vector<PilotResult>& candidates, std::string* reason);
+
+// Renders samples [settings.first_sample, + settings.spp) of the whole film with the chosen
+// candidate after exploring all (see the file comment); the film's sums are weighted so that its
+// mean is the unbiased image and its count per pixel is spp. Leaves `renderer` set to the chosen
+// candidate. Without room to explore (plan_exploration), the last candidate renders it all.
+AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
+                       const RenderSettings& settings);
+
+// One line for logs: "auto: tree (exploration 3 of 16 spp in 0.84 s; efficiency power 12.3 (0.05
+// s/pass, weight 0.1), ...)".
 std::string describe(const AutoChoice& choice);
 
 } // namespace canopy
