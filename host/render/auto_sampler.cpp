@@ -126,6 +126,9 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(worst - 1), v.end(), std::greater<>());
   const double top = std::accumulate(v.begin(), v.begin() + std::ptrdiff_t(worst), 0.0);
   st.tail_share = total > 0.0 ? top / total : 0.0;
+  st.tile_variance.resize(tile_sum.size());
+  for (size_t t = 0; t < tile_sum.size(); ++t)
+    st.tile_variance[t] = tile_sum[t] / n;
   if (clear > 0) {
     st.mean = mean / double(clear);
     st.mean_variance = mean_var / (double(clear) * double(clear));
@@ -167,6 +170,25 @@ std::vector<double> exploration_weights(const std::vector<ExploreStats>& other) 
   return w;
 }
 
+namespace {
+
+// Whether a's variance x seconds per pass is below b's by more than 1.96 standard errors of the
+// difference, estimated over the tiles (render/auto_sampler.h, choose_candidate).
+bool significantly_better(const PilotResult& a, const PilotResult& b) {
+  const std::vector<double>&ta = a.stats.tile_variance, &tb = b.stats.tile_variance;
+  const double diff = b.stats.variance * b.pass_seconds - a.stats.variance * a.pass_seconds;
+  if (ta.size() != tb.size() || ta.empty()) return diff > 0.0;
+  const double tiles = double(ta.size());
+  double dev = 0.0;
+  for (size_t t = 0; t < ta.size(); ++t) {
+    const double d = tb[t] * b.pass_seconds - ta[t] * a.pass_seconds - diff / tiles;
+    dev += d * d;
+  }
+  return diff > 1.96 * std::sqrt(tiles / (tiles - 1.0) * dev);
+}
+
+} // namespace
+
 size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
   std::vector<ExploreStats> stats;
   for (const PilotResult& p : c)
@@ -198,14 +220,13 @@ size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
   size_t lighter = c.size();
   for (size_t i = 0; i < c.size(); ++i) {
     if (i == best || !ranked(i)) continue;
-    const bool overlap =
-        c[i].efficiency_hi >= c[best].efficiency_lo && c[best].efficiency_hi >= c[i].efficiency_lo;
-    if (overlap && c[i].stats.tail_share <= 0.5 * c[best].stats.tail_share &&
+    if (!significantly_better(c[best], c[i]) &&
+        c[i].stats.tail_share <= 0.5 * c[best].stats.tail_share &&
         (lighter == c.size() || c[i].efficiency > c[lighter].efficiency))
       lighter = i;
   }
   if (lighter != c.size()) {
-    *reason = fmt::format("efficiency within {}'s interval, lighter tail", c[best].label);
+    *reason = fmt::format("not significantly less efficient than {}, lighter tail", c[best].label);
     return lighter;
   }
   return best;

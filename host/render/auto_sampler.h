@@ -29,6 +29,10 @@ struct ExploreStats {
   // Over the pixels whose camera rays saw no emitter: the image's mean value and that mean's
   // variance (the missed-tail test).
   double mean = 0.0, mean_variance = 0.0;
+  // Per tile of the film (8 x 8): the sum of its pixels' variances, divided by the pixel count
+  // (so they add up to `variance`). Candidates are compared tile by tile: a tile's variance
+  // depends mostly on what the tile shows, the same for every candidate.
+  std::vector<double> tile_variance;
 };
 
 // A candidate's measurements from its film: over the pixels of the film's half `half` (0 or 1, a
@@ -88,9 +92,12 @@ std::vector<double> exploration_weights(const std::vector<ExploreStats>& other);
 
 // Marks the candidates that missed their tail (mean more than 4 standard errors below the median
 // candidate's), then returns the chosen one's index: the most efficient of the rest, unless a
-// candidate whose efficiency interval overlaps its interval has at most half its tail share (the
-// lighter tail is taken: a heavy tail's variance from a few samples is unreliable). Without a
-// measured variance (a black image), the fastest. Sets `reason`.
+// candidate that it does not beat significantly has at most half its tail share (the lighter tail
+// is taken: a heavy tail's variance from a few samples is unreliable). "Significantly": the
+// difference of variance x seconds per pass, summed over tiles, exceeds 1.96 standard errors of
+// that sum estimated from the tiles' differences (a paired comparison: the spread between tiles
+// that every candidate shares cancels). Without a measured variance (a black image), the fastest.
+// Sets `reason`.
 size_t choose_candidate(std::vector<PilotResult>& candidates, std::string* reason);
 
 // Renders samples [settings.first_sample, + settings.spp) of the whole film with the chosen
