@@ -799,10 +799,11 @@ int run_converge(const ConvergeArgs& a) {
     res.warmup_seconds = timed_render(ci, warm_spp, 0xC0FFEEu, nullptr);
     std::string timing;
     if (equal_time) {
-      // Timing renders (not recorded, their own seed): the spp of one render of ~equal_time s.
+      // Timing renders (not recorded, their own seed): the spp of one render of ~equal_time s
+      // (auto probes from 16 spp: with fewer it has no room to explore).
       res.timing_seconds = spp_for_seconds(
           [&](int spp, uint32_t seed) { return timed_render(ci, spp, seed, nullptr); },
-          a.equal_time, a.spp_start, a.max_spp, 0xC0FFEEu + 1, &equal_spp[ci]);
+          a.equal_time, warm_spp, a.max_spp, 0xC0FFEEu + 1, &equal_spp[ci]);
       timing = fmt::format(", timing {:.2f} s: {} spp", res.timing_seconds, equal_spp[ci]);
     }
     progress.show(fmt::format("[{}/{}] {:<16} build {:.3f} s (light tree {:.3f} s), compile "
