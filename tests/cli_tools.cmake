@@ -84,6 +84,17 @@ if(MODE STREQUAL "compare")
   run_canopy(0 compare "${DIR}/a.exr" "${DIR}/a.exr" --json)
   expect_contains("${out}" "\"rmse\": 0.0")
   expect_contains("${out}" "\"psnr\": \"inf\"")
+  # --mask: the per-pixel MSE over all pixels and over those the mask leaves out. D is A with its
+  # left half at 0.25 (squared error 0.0625 there), the mask white on that half.
+  execute_process(COMMAND "${OIIOTOOL}" --pattern "constant:color=0.25,0.25,0.25" 4x6 3
+                          "${DIR}/a.exr" --paste +0+0 -o "${DIR}/d.exr")
+  execute_process(COMMAND "${OIIOTOOL}" --pattern "constant:color=1,1,1" 4x6 3
+                          --pattern "constant:color=0,0,0" 8x6 3 --paste +0+0 -d uint8
+                          -o "${DIR}/mask.png")
+  run_canopy(0 compare "${DIR}/d.exr" "${DIR}/a.exr" --mask "${DIR}/mask.png")
+  expect_contains("${out}" "pixel MSE  3.125000e-02 (all), 0.000000e+00 (the 24 pixels")
+  run_canopy(2 compare "${DIR}/d.exr" "${DIR}/a.exr" --mask "${DIR}/small.exr")
+  expect_contains("${err}" "${DIR}/small.exr: size differs from ${DIR}/a.exr (8x6)")
   # Invalid input: exit code 2 and one line naming the file.
   run_canopy(2 compare "${DIR}/a.exr" "${DIR}/missing.exr")
   expect_contains("${err}" "${DIR}/missing.exr: cannot read image")

@@ -1,5 +1,6 @@
 #include "cli/compare_command.h"
 
+#include "image/error_stats.h"
 #include "image/image_compare.h"
 #include "image/image_io.h"
 #include "scene/scene.h"
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace canopy {
@@ -19,6 +21,7 @@ namespace {
 
 struct CompareArgs {
   std::string test, reference, error_image;
+  std::string mask; // a PNG: white pixels (an emitter in view) are left out of the masked MSE
   double error_scale = 0.0;
   double clamp = 0.0; // > 0: clamp both images to [0, clamp] first
   bool relative = false;
@@ -57,6 +60,16 @@ int run_compare(const CompareArgs& a) {
     ref = clamp_image(ref, float(a.clamp));
   }
   ImageMetrics m = compare_images(test, ref);
+  // With a mask: the MSE over all pixels and over the unmasked ones (the yardstick's two sets).
+  std::optional<PixelErrorStats> all, clear;
+  if (!a.mask.empty()) {
+    std::vector<uint8_t> mask = mask_from_image(read_input(a.mask));
+    if (mask.size() != size_t(ref.width) * size_t(ref.height))
+      throw SceneError(fmt::format("{}: size differs from {} ({}x{})", a.mask, a.reference,
+                                   ref.width, ref.height));
+    all = pixel_error_stats(test, ref);
+    clear = pixel_error_stats(test, ref, mask);
+  }
 
   double used_scale = 0.0;
   if (!a.error_image.empty()) {
@@ -81,6 +94,13 @@ int run_compare(const CompareArgs& a) {
     j["max_abs_error"] = m.max_abs;
     j["nonfinite"] = m.nonfinite;
     if (!a.error_image.empty()) j["error_image"] = {{"file", a.error_image}, {"scale", used_scale}};
+    if (all) {
+      j["mask"] = a.mask;
+      j["pixel_mse"] = all->mse;
+      j["pixel_mse_unmasked"] = clear->mse;
+      j["unmasked_pixels"] = clear->pixels;
+      j["top_share"] = all->top_share;
+    }
     std::printf("%s\n", j.dump(2).c_str());
     return 0;
   }
@@ -96,6 +116,9 @@ int run_compare(const CompareArgs& a) {
     std::printf("PSNR       inf dB\n");
   std::printf("max |A-B|  %.6e\n", m.max_abs);
   if (m.nonfinite) std::printf("non-finite %zu values in %s\n", m.nonfinite, a.test.c_str());
+  if (all)
+    std::printf("pixel MSE  %.6e (all), %.6e (the %zu pixels %s leaves out)\n", all->mse,
+                clear->mse, clear->pixels, a.mask.c_str());
   if (!a.error_image.empty())
     std::printf("wrote %s (%s error, scale %.4g = white)\n", a.error_image.c_str(),
                 a.relative ? "relative" : "absolute", used_scale);
@@ -122,6 +145,9 @@ CLI::App* add_compare_command(CLI::App& app, std::function<int()>& action) {
                   "Clamp both images to [0, V] before measuring (display-referred error)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", args->json, "Print the results as JSON");
+  cmd->add_option("--mask", args->mask,
+                  "An emitter mask PNG (render --emitter-mask): also report the per-pixel MSE "
+                  "over all pixels and over the black ones (no emitter in view)");
   cmd->footer("Definitions: RMSE = sqrt(mean (A-B)^2) over pixels and RGB channels; relMSE = "
               "mean (A-B)^2 / (B^2 + 0.01); PSNR = 10 log10(peak^2 / MSE) with peak = max(1, "
               "largest value in A or B), as OpenImageIO's idiff.");
