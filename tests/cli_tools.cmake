@@ -118,13 +118,13 @@ elseif(MODE STREQUAL "converge")
     expect_contains("${rows}" "${s}")
   endforeach()
   # The mis column (before max_depth, mode, timing_seconds, auto_choice, pilot_seconds): /nomis
-  # renders with MIS off, every other configuration with MIS on; auto names the candidate its
-  # pilot chose.
+  # renders with MIS off, every other configuration with MIS on; auto names the candidates its
+  # explorations chose, with their counts.
   file(STRINGS "${DIR}/tiny-configs.csv" cfg_rows)
   foreach(re "^tiny_converge,tree-split:0.5/nomis,tree-split,0.5,.*,0,1,curve,[0-9.]+,,0.000$"
              "^tiny_converge,tree-split:0.5,tree-split,0.5,.*,1,1,curve,[0-9.]+,,0.000$"
              "^tiny_converge,power,power,.*,1,1,curve,[0-9.]+,,0.000$"
-             "^tiny_converge,auto,auto,.*,1,1,curve,[0-9.]+,(power|tree|brdf-mis/split=0.25),[0-9.]+$")
+             "^tiny_converge,auto,auto,.*,1,1,curve,[0-9.]+,(power|tree|brdf-mis/split=0.25) x[0-9]+( (power|tree|brdf-mis/split=0.25) x[0-9]+)*,[0-9.]+$")
     set(hits ${cfg_rows})
     list(FILTER hits INCLUDE REGEX "${re}")
     list(LENGTH hits n)
