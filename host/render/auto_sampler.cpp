@@ -26,8 +26,9 @@ std::vector<PilotResult> auto_candidates(const RendererOptions& base) {
 std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, int* renders) {
   *renders = 0;
   const int n = int(wave_passes.size());
-  // At most 60% of the samples, and one left for the chosen candidate.
-  const int budget = std::min(spp - 1, int(0.6 * double(spp)));
+  // At most 60% of the samples, or the least exploration (an untimed and a timed pass each: two
+  // samples per pixel give a variance) where that is more; one left for the chosen candidate.
+  const int budget = std::min(spp - 1, std::max(int(0.6 * double(spp)), 2 * n));
   const double want = double(std::accumulate(wave_passes.begin(), wave_passes.end(), 0));
   for (int r = 2; r >= 1; --r) {
     // Each candidate: 1 untimed pass + r timed renders of p passes, p scaled down to fit.
