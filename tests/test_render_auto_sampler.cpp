@@ -76,8 +76,8 @@ TEST(AutoSampler, TheExplorationFitsTheSampleBudget) {
   EXPECT_EQ(renders, 2);
 }
 
-// Inverse-variance weights relative to the least variance, capped at 1; a candidate that missed
-// its tail weighs nothing and does not set the reference.
+// Inverse-variance weights relative to the least noisy candidate, by the typical tile, at most 1; a
+// candidate that missed its tail weighs nothing and does not set the reference.
 TEST(AutoSampler, ExplorationWeightsAreInverseVarianceAndDropAMissedTail) {
   std::vector<ExploreStats> s(3);
   s[0].variance = 1e-4; // low only because it missed its tail: its mean is far too low
@@ -89,10 +89,18 @@ TEST(AutoSampler, ExplorationWeightsAreInverseVarianceAndDropAMissedTail) {
   s[2].variance = 8.0;
   s[2].mean = 1.001;
   s[2].mean_variance = 1e-6;
+  s[1].tile_variance.assign(32, 2.0 / 32);
+  s[2].tile_variance.assign(32, 8.0 / 32); // 4x in every tile: significant
+  s[0].tile_variance.assign(32, 1e-4 / 32);
   std::vector<double> w = exploration_weights(s);
   EXPECT_EQ(w[0], 0.0);
   EXPECT_EQ(w[1], 1.0);
   EXPECT_DOUBLE_EQ(w[2], 0.25);
+  // 1.5x as noisy, but all of the excess in one tile: the typical tile is as noisy, weight 1.
+  s[2].variance = 3.0;
+  s[2].tile_variance.assign(32, 2.0 / 32);
+  s[2].tile_variance[5] += 1.0;
+  EXPECT_EQ(exploration_weights(s)[2], 1.0);
 }
 
 // The most efficient is chosen. A leader whose lead over another is not significant tile by tile

@@ -127,9 +127,8 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(worst - 1), v.end(), std::greater<>());
   const double top = std::accumulate(v.begin(), v.begin() + std::ptrdiff_t(worst), 0.0);
   st.tail_share = total > 0.0 ? top / total : 0.0;
-  st.tile_variance.resize(tile_sum.size());
   for (size_t t = 0; t < tile_sum.size(); ++t)
-    st.tile_variance[t] = tile_sum[t] / n;
+    if (tile_n[t] > 0.0) st.tile_variance.push_back(tile_sum[t] / n);
   if (clear > 0) {
     st.mean = mean / double(clear);
     st.mean_variance = mean_var / (double(clear) * double(clear));
@@ -156,39 +155,51 @@ std::vector<bool> missed_tails(const std::vector<ExploreStats>& s) {
   return out;
 }
 
-} // namespace
-
-std::vector<double> exploration_weights(const std::vector<ExploreStats>& other) {
-  const std::vector<bool> missed = missed_tails(other);
-  double vmin = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < other.size(); ++i)
-    if (!missed[i]) vmin = std::min(vmin, other[i].variance);
-  std::vector<double> w(other.size(), 0.0);
-  for (size_t i = 0; i < other.size(); ++i) {
-    if (missed[i]) continue;
-    w[i] = other[i].variance > 0.0 ? std::min(1.0, vmin / other[i].variance) : 1.0;
-  }
-  return w;
-}
-
-namespace {
-
-// Whether a's variance x seconds per pass is below b's by more than 1.96 standard errors of the
-// difference, estimated over the tiles (render/auto_sampler.h, choose_candidate).
-bool significantly_better(const PilotResult& a, const PilotResult& b) {
-  const std::vector<double>&ta = a.stats.tile_variance, &tb = b.stats.tile_variance;
-  const double diff = b.stats.variance * b.pass_seconds - a.stats.variance * a.pass_seconds;
-  if (ta.size() != tb.size() || ta.empty()) return diff > 0.0;
+// Whether a's variance x ka is below b's x kb by more than 1.96 standard errors of the
+// difference, estimated from the tiles' differences (a paired comparison: what a tile shows sets
+// its variance for every candidate, and that spread cancels).
+bool significantly_less(const ExploreStats& a, double ka, const ExploreStats& b, double kb) {
+  const std::vector<double>&ta = a.tile_variance, &tb = b.tile_variance;
+  const double diff = b.variance * kb - a.variance * ka;
+  if (ta.size() != tb.size() || ta.size() < 2) return diff > 0.0;
   const double tiles = double(ta.size());
   double dev = 0.0;
   for (size_t t = 0; t < ta.size(); ++t) {
-    const double d = tb[t] * b.pass_seconds - ta[t] * a.pass_seconds - diff / tiles;
+    const double d = tb[t] * kb - ta[t] * ka - diff / tiles;
     dev += d * d;
   }
   return diff > 1.96 * std::sqrt(tiles / (tiles - 1.0) * dev);
 }
 
 } // namespace
+
+std::vector<double> exploration_weights(const std::vector<ExploreStats>& other) {
+  const std::vector<bool> missed = missed_tails(other);
+  size_t least = other.size();
+  for (size_t i = 0; i < other.size(); ++i)
+    if (!missed[i] && (least == other.size() || other[i].variance < other[least].variance))
+      least = i;
+  std::vector<double> w(other.size(), 0.0);
+  for (size_t i = 0; i < other.size(); ++i) {
+    if (missed[i]) continue;
+    // The typical tile's excess, the median over tiles of the variance ratio to the least noisy
+    // candidate: the image's variance can be a few pixels' (the edges of small bright emitters
+    // in view, the same for every candidate), whose noise would make the ratio of the means, and
+    // so the weights, unequal where the samples are equally good, which adds variance.
+    std::vector<double> ratio;
+    const std::vector<double>&ti = other[i].tile_variance, &tl = other[least].tile_variance;
+    for (size_t t = 0; t < std::min(ti.size(), tl.size()); ++t)
+      if (tl[t] > 0.0) ratio.push_back(ti[t] / tl[t]);
+    double excess = other[least].variance > 0.0 ? other[i].variance / other[least].variance : 1.0;
+    if (!ratio.empty()) {
+      std::nth_element(ratio.begin(), ratio.begin() + std::ptrdiff_t(ratio.size() / 2),
+                       ratio.end());
+      excess = ratio[ratio.size() / 2];
+    }
+    w[i] = excess > 1.0 ? 1.0 / excess : 1.0;
+  }
+  return w;
+}
 
 size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
   std::vector<ExploreStats> stats;
@@ -221,7 +232,7 @@ size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
   size_t lighter = c.size();
   for (size_t i = 0; i < c.size(); ++i) {
     if (i == best || !ranked(i)) continue;
-    if (!significantly_better(c[best], c[i]) &&
+    if (!significantly_less(c[best].stats, c[best].pass_seconds, c[i].stats, c[i].pass_seconds) &&
         c[i].stats.tail_share <= 0.5 * c[best].stats.tail_share &&
         (lighter == c.size() || c[i].efficiency > c[lighter].efficiency))
       lighter = i;

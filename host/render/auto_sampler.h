@@ -86,9 +86,11 @@ std::vector<PilotResult> auto_candidates(const RendererOptions& base);
 std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, int* renders);
 
 // The weights of the candidates' samples in one half of the film, from `other`, their
-// measurements over the other half: 0 for a candidate that missed its tail there, else
-// min(1, V_min / V), with V_min the least variance among those that did not. Inverse-variance
-// weights relative to the best, capped at 1 so the remaining samples' weight is at least 1.
+// measurements over the other half: 0 for a candidate that missed its tail there; else
+// min(1, 1 / m), m the median over tiles of its variance over that of the least noisy candidate
+// that did not. Inverse-variance weights relative to the best, at most 1 so the remaining samples'
+// weight is at least 1; the typical tile's ratio rather than the ratio of the image means, which a
+// few noisy pixels can swing: unequal weights on equally good samples add variance.
 std::vector<double> exploration_weights(const std::vector<ExploreStats>& other);
 
 // Marks the candidates that missed their tail (mean more than 4 standard errors below the median
