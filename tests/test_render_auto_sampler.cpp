@@ -76,31 +76,38 @@ TEST(AutoSampler, TheExplorationFitsTheSampleBudget) {
   EXPECT_EQ(renders, 2);
 }
 
-// Inverse-variance weights relative to the least noisy candidate, by the typical tile, at most 1; a
-// candidate that missed its tail weighs nothing and does not set the reference.
-TEST(AutoSampler, ExplorationWeightsAreInverseVarianceAndDropAMissedTail) {
-  std::vector<ExploreStats> s(3);
-  s[0].variance = 1e-4; // low only because it missed its tail: its mean is far too low
-  s[0].mean = 0.5;
-  s[0].mean_variance = 1e-6;
-  s[1].variance = 2.0;
-  s[1].mean = 1.0;
-  s[1].mean_variance = 1e-6;
-  s[2].variance = 8.0;
-  s[2].mean = 1.001;
-  s[2].mean_variance = 1e-6;
-  s[1].tile_variance.assign(32, 2.0 / 32);
-  s[2].tile_variance.assign(32, 8.0 / 32); // 4x in every tile: significant
-  s[0].tile_variance.assign(32, 1e-4 / 32);
-  std::vector<double> w = exploration_weights(s);
+// Inverse-variance weights relative to the predicted choice, by the typical tile, at most 1; a
+// candidate that missed its tail weighs nothing and is not the reference.
+TEST(AutoSampler, ExplorationWeightsAreInverseVarianceToTheChoiceAndDropAMissedTail) {
+  std::vector<PilotResult> c(3);
+  auto set = [&](size_t i, double v, double mean, double tile_v) {
+    c[i].label = "c" + std::to_string(i);
+    c[i].stats.variance = v;
+    c[i].stats.mean = mean;
+    c[i].stats.mean_variance = 1e-6;
+    c[i].stats.tile_variance.assign(32, tile_v / 32);
+    c[i].pass_seconds = 1.0;
+  };
+  set(0, 1e-4, 0.5, 1e-4); // low only because it missed its tail: its mean is far too low
+  set(1, 2.0, 1.0, 2.0);
+  set(2, 8.0, 1.001, 8.0); // 4x in every tile
+  std::vector<double> w = exploration_weights(c);
   EXPECT_EQ(w[0], 0.0);
   EXPECT_EQ(w[1], 1.0);
   EXPECT_DOUBLE_EQ(w[2], 0.25);
   // 1.5x as noisy, but all of the excess in one tile: the typical tile is as noisy, weight 1.
-  s[2].variance = 3.0;
-  s[2].tile_variance.assign(32, 2.0 / 32);
-  s[2].tile_variance[5] += 1.0;
-  EXPECT_EQ(exploration_weights(s)[2], 1.0);
+  c[2].stats.variance = 3.0;
+  c[2].stats.tile_variance.assign(32, 2.0 / 32);
+  c[2].stats.tile_variance[5] += 1.0;
+  EXPECT_EQ(exploration_weights(c)[2], 1.0);
+  // A noisier candidate, 10x cheaper, is the choice: its samples weigh 1, and so do the better
+  // samples of the other (at most 1).
+  set(2, 8.0, 1.001, 8.0);
+  c[2].pass_seconds = 0.1;
+  w = exploration_weights(c);
+  EXPECT_EQ(w[0], 0.0);
+  EXPECT_EQ(w[1], 1.0);
+  EXPECT_EQ(w[2], 1.0);
 }
 
 // The most efficient is chosen. A leader whose lead over another is not significant tile by tile

@@ -173,34 +173,6 @@ bool significantly_less(const ExploreStats& a, double ka, const ExploreStats& b,
 
 } // namespace
 
-std::vector<double> exploration_weights(const std::vector<ExploreStats>& other) {
-  const std::vector<bool> missed = missed_tails(other);
-  size_t least = other.size();
-  for (size_t i = 0; i < other.size(); ++i)
-    if (!missed[i] && (least == other.size() || other[i].variance < other[least].variance))
-      least = i;
-  std::vector<double> w(other.size(), 0.0);
-  for (size_t i = 0; i < other.size(); ++i) {
-    if (missed[i]) continue;
-    // The typical tile's excess, the median over tiles of the variance ratio to the least noisy
-    // candidate: the image's variance can be a few pixels' (the edges of small bright emitters
-    // in view, the same for every candidate), whose noise would make the ratio of the means, and
-    // so the weights, unequal where the samples are equally good, which adds variance.
-    std::vector<double> ratio;
-    const std::vector<double>&ti = other[i].tile_variance, &tl = other[least].tile_variance;
-    for (size_t t = 0; t < std::min(ti.size(), tl.size()); ++t)
-      if (tl[t] > 0.0) ratio.push_back(ti[t] / tl[t]);
-    double excess = other[least].variance > 0.0 ? other[i].variance / other[least].variance : 1.0;
-    if (!ratio.empty()) {
-      std::nth_element(ratio.begin(), ratio.begin() + std::ptrdiff_t(ratio.size() / 2),
-                       ratio.end());
-      excess = ratio[ratio.size() / 2];
-    }
-    w[i] = excess > 1.0 ? 1.0 / excess : 1.0;
-  }
-  return w;
-}
-
 size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
   std::vector<ExploreStats> stats;
   for (const PilotResult& p : c)
@@ -242,6 +214,31 @@ size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
     return lighter;
   }
   return best;
+}
+
+std::vector<double> exploration_weights(std::vector<PilotResult> other) {
+  std::string reason;
+  const size_t ref = choose_candidate(other, &reason);
+  std::vector<double> w(other.size(), 0.0);
+  for (size_t i = 0; i < other.size(); ++i) {
+    if (other[i].missed_tail) continue;
+    // The typical tile's excess, the median over tiles of the variance ratio to the predicted
+    // choice: the image's variance can be a few pixels' (the edges of small bright emitters in
+    // view, the same for every candidate), whose noise would make the ratio of the means, and so
+    // the weights, unequal where the samples are equally good, which adds variance.
+    const ExploreStats &si = other[i].stats, &sr = other[ref].stats;
+    std::vector<double> ratio;
+    for (size_t t = 0; t < std::min(si.tile_variance.size(), sr.tile_variance.size()); ++t)
+      if (sr.tile_variance[t] > 0.0) ratio.push_back(si.tile_variance[t] / sr.tile_variance[t]);
+    double excess = sr.variance > 0.0 ? si.variance / sr.variance : 1.0;
+    if (!ratio.empty()) {
+      std::nth_element(ratio.begin(), ratio.begin() + std::ptrdiff_t(ratio.size() / 2),
+                       ratio.end());
+      excess = ratio[ratio.size() / 2];
+    }
+    w[i] = excess > 1.0 ? 1.0 / excess : 1.0;
+  }
+  return w;
 }
 
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
@@ -323,7 +320,10 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   }
   // Half h's samples are weighted by the other half's measurements.
   for (int h = 0; h < 2; ++h) {
-    const std::vector<double> w = exploration_weights(halves[1 - h]);
+    std::vector<PilotResult> other = cand;
+    for (size_t i = 0; i < cand.size(); ++i)
+      other[i].stats = halves[1 - h][i];
+    const std::vector<double> w = exploration_weights(other);
     for (size_t i = 0; i < cand.size(); ++i)
       cand[i].weight[h] = w[i];
   }

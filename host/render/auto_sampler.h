@@ -85,14 +85,6 @@ std::vector<PilotResult> auto_candidates(const RendererOptions& base);
 // explore (spp <= 2 x candidates: then the last candidate renders everything).
 std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, int* renders);
 
-// The weights of the candidates' samples in one half of the film, from `other`, their
-// measurements over the other half: 0 for a candidate that missed its tail there; else
-// min(1, 1 / m), m the median over tiles of its variance over that of the least noisy candidate
-// that did not. Inverse-variance weights relative to the best, at most 1 so the remaining samples'
-// weight is at least 1; the typical tile's ratio rather than the ratio of the image means, which a
-// few noisy pixels can swing: unequal weights on equally good samples add variance.
-std::vector<double> exploration_weights(const std::vector<ExploreStats>& other);
-
 // Marks the candidates that missed their tail (mean more than 4 standard errors below the median
 // candidate's), then returns the chosen one's index: the most efficient of the rest, unless a
 // candidate that it does not beat significantly has at most half its tail share (the lighter tail
@@ -102,6 +94,16 @@ std::vector<double> exploration_weights(const std::vector<ExploreStats>& other);
 // that every candidate shares cancels). Without a measured variance (a black image), the fastest.
 // Sets `reason`.
 size_t choose_candidate(std::vector<PilotResult>& candidates, std::string* reason);
+
+// The weights of the candidates' samples in one half of the film, from `other`: the candidates
+// with their measurements over the other half (and their seconds per pass). The choice those
+// measurements predict (choose_candidate) is the reference: a candidate that missed its tail
+// weighs 0, the others min(1, 1 / m), m the median over tiles of its variance over the
+// reference's. Inverse-variance weights relative to the samples that will render the rest, at
+// most 1 so the rest's weight is at least 1; the typical tile's ratio rather than the ratio of the
+// image means, which a few noisy pixels can swing: unequal weights on equally good samples add
+// variance.
+std::vector<double> exploration_weights(std::vector<PilotResult> other);
 
 // Renders samples [settings.first_sample, + settings.spp) of the whole film with the chosen
 // candidate after exploring all (see the file comment); the film's sums are weighted so that its
