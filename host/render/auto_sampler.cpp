@@ -340,25 +340,31 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   rs.first_sample = next;
   rs.spp = settings.first_sample + settings.spp - next;
   Film rest = renderer.render(rs);
-  double explored[2] = {0.0, 0.0};
-  for (int h = 0; h < 2; ++h)
-    for (const PilotResult& c : cand)
-      explored[h] += c.weight[h] * double(c.samples);
-  std::vector<double> w(rest.sum.size());
-  for (size_t p = 0; p < w.size(); ++p)
-    w[p] = (double(settings.spp) - explored[half_of(rest, p)]) / double(rs.spp);
+  // A candidate's weight at a pixel: 1 where another candidate's camera rays saw an emitter there
+  // (that pixel's noise is mostly the emitter's edge, the same for every candidate, and unequal
+  // weights on equally good samples add variance), else its weight in the pixel's half. Both
+  // depend on other samples than the ones they weight.
+  const size_t npixels = rest.sum.size();
+  std::vector<std::vector<double>> wc(cand.size(), std::vector<double>(npixels));
+  std::vector<double> w(npixels, double(settings.spp));
+  for (size_t i = 0; i < cand.size(); ++i)
+    for (size_t p = 0; p < npixels; ++p) {
+      bool edge = false;
+      for (size_t d = 0; d < cand.size(); ++d)
+        edge = edge || (d != i && films[d].counts[p].z > 0.0);
+      wc[i][p] = edge ? 1.0 : cand[i].weight[half_of(rest, p)];
+      w[p] -= wc[i][p] * double(cand[i].samples);
+    }
+  for (double& x : w)
+    x /= double(rs.spp);
   out.film = std::move(rest);
   for (size_t p = 0; p < w.size(); ++p) {
     double4 &x = out.film.sum[p], &q = out.film.sumsq[p];
     x.x *= w[p], x.y *= w[p], x.z *= w[p];
     q.x *= w[p] * w[p], q.y *= w[p] * w[p], q.z *= w[p] * w[p];
   }
-  for (size_t i = 0; i < cand.size(); ++i) {
-    std::vector<double> wi(w.size());
-    for (size_t p = 0; p < wi.size(); ++p)
-      wi[p] = cand[i].weight[half_of(out.film, p)];
-    add_samples(out.film, films[i], &wi);
-  }
+  for (size_t i = 0; i < cand.size(); ++i)
+    add_samples(out.film, films[i], &wc[i]);
   return out;
 }
 
