@@ -26,6 +26,24 @@ const char* kGridJson = R"({
                     "light": { "type": "point", "intensity": 1 } } ]
 })";
 
+// A scene's renderer, built for the first candidate as `canopy render` builds it, and its auto
+// renders.
+struct AutoRun {
+  explicit AutoRun(const std::string& json)
+      : scene(load_scene_from_string(json, "scene.json", ".")),
+        base(auto_candidates(RendererOptions{}).front().options), renderer(rt, scene, base) {}
+  AutoRender render(int spp, uint32_t seed) {
+    RenderSettings rs;
+    rs.spp = spp;
+    rs.seed = seed;
+    return render_auto(renderer, base, rs);
+  }
+  Scene scene;
+  ClRuntime rt;
+  RendererOptions base;
+  Renderer renderer;
+};
+
 } // namespace
 
 TEST(AutoSampler, CandidatesArePowerTreeAndTheSplitBrdfMis) {
@@ -150,14 +168,11 @@ TEST(AutoSampler, TheChoiceIsTheMostEfficientUnlessALighterTailIsNotSignificantl
 // Power sampling is hopeless here: the exploration must see it, its samples must weigh little,
 // every pixel gets exactly spp samples, and the renderer ends on the chosen candidate.
 TEST(AutoSampler, TheExplorationRanksByEfficiencyAndItsSamplesArePartOfTheImage) {
-  Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
-  ClRuntime rt;
-  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
-  Renderer renderer(rt, scene, base);
+  AutoRun run(kGridJson);
+  Renderer& renderer = run.renderer;
   RenderSettings rs;
   rs.spp = 32;
-  rs.seed = 7;
-  AutoRender r = render_auto(renderer, base, rs);
+  AutoRender r = run.render(rs.spp, 7);
   const AutoChoice& choice = r.choice;
   ASSERT_EQ(choice.candidates.size(), 3u);
   int explored = 0;
@@ -309,18 +324,16 @@ TEST(AutoSampler, AHeavyTailSceneIsRankedCorrectly) {
 
 // Too few samples to explore: the last candidate renders it all, as a partial render would.
 TEST(AutoSampler, WithoutRoomToExploreTheLastCandidateRenders) {
-  Scene scene = load_scene_from_string(kGridJson, "grid.json", ".");
-  ClRuntime rt;
-  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
-  Renderer renderer(rt, scene, base);
-  RenderSettings rs;
-  rs.spp = 6;
-  rs.seed = 3;
-  AutoRender r = render_auto(renderer, base, rs);
+  AutoRun run(kGridJson);
+  AutoRender r = run.render(6, 3);
+  const RendererOptions& base = run.base;
   EXPECT_TRUE(r.choice.candidates.empty());
   EXPECT_EQ(r.choice.chosen.label, auto_candidates(base).back().label);
   RendererOptions last = auto_candidates(base).back().options;
-  Renderer fresh(rt, scene, last);
+  Renderer fresh(run.rt, run.scene, last);
+  RenderSettings rs;
+  rs.spp = 6;
+  rs.seed = 3;
   Film f = fresh.render(rs);
   for (size_t p = 0; p < f.sum.size(); ++p)
     ASSERT_EQ(f.sum[p].x, r.film.sum[p].x) << p;
@@ -331,14 +344,8 @@ TEST(AutoSampler, WithoutRoomToExploreTheLastCandidateRenders) {
 TEST(AutoSampler, ABlackScenePicksTheFastest) {
   std::string json = kGridJson;
   json.replace(json.find("\"intensity\": 1"), 14, "\"intensity\": 0");
-  Scene scene = load_scene_from_string(json, "black.json", ".");
-  ClRuntime rt;
-  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
-  Renderer renderer(rt, scene, base);
-  RenderSettings rs;
-  rs.spp = 16;
-  rs.seed = 7;
-  AutoRender r = render_auto(renderer, base, rs);
+  AutoRun run(json);
+  AutoRender r = run.render(16, 7);
   const AutoChoice& choice = r.choice;
   ASSERT_EQ(choice.candidates.size(), 3u);
   double fastest = 1e300;
@@ -366,14 +373,8 @@ TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRankedNorWeighted) {
                       "edge2": [0, 0, 20000], "nx": 256, "ny": 256,
                       "light": { "type": "point", "intensity": 100 } } ]
   })";
-  Scene scene = load_scene_from_string(json, "tail.json", ".");
-  ClRuntime rt;
-  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
-  Renderer renderer(rt, scene, base);
-  RenderSettings rs;
-  rs.spp = 32;
-  rs.seed = 11;
-  AutoChoice choice = render_auto(renderer, base, rs).choice;
+  AutoRun run(json);
+  AutoChoice choice = run.render(32, 11).choice;
   EXPECT_TRUE(choice.candidates[0].missed_tail) << describe(choice);
   EXPECT_FALSE(choice.candidates[1].missed_tail) << describe(choice);
   EXPECT_NE(choice.chosen.label, "power");
