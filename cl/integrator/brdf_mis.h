@@ -116,12 +116,26 @@ INLINE float brdf_light_pmf_weight(const LightSamplerCtx* ls, const PathBuffers*
                             light_query_normal(pb, path), light);
 }
 
+// Whether the tree estimate of a light at the point is exact: a delta light (point, spot) that the
+// tree-split cut takes with probability pmf_split = 1 (an emitter of a split leaf, or alone below
+// its cluster). Nothing is sampled for it: its Li is exact and the pick is certain.
+INLINE int brdf_tree_exact(float pmf_split, int is_delta) {
+  return is_delta && pmf_split >= 1.0f;
+}
+
 // Weight of the tree light sample (density p_L) against N BRDF-aware samples drawn with share s
 // of BRDF-oriented light sampling; p_B' = brdf_light_pmf_weight times the light's density (see
-// the top).
+// the top). Where the tree estimate is exact (brdf_tree_exact) it keeps the whole weight: the
+// power heuristic compares densities, p_L = 1 against N s p_B', and would hand up to all of the
+// light to the BRDF-aware samples, whose estimate of it is noisy (their number of light samples is
+// random: each is BRDF-oriented with probability p_i, its contribution scaled by 1 / p_i; under a
+// single point light a tree-split estimate without variance became one with it). w_L = 1 is a
+// function of the light and the point alone, so the weights still sum to 1 for every light point
+// and the estimator stays unbiased (the BRDF-oriented samples of such a light weigh 0).
 INLINE float brdf_weight_tree(const LightSamplerCtx* ls, float p_L, float p_Bw, float p_S, int N,
-                              float s) {
+                              float s, int tree_exact) {
   if (ls->kind == SAMPLER_BRDF_ORIENTED) return 0.0f;
+  if (tree_exact) return 1.0f;
   return power_heuristic(p_L, (float)N * (s * p_Bw + (1.0f - s) * p_S));
 }
 
@@ -203,14 +217,16 @@ INLINE int brdf_sample_item(int path, int round, const LightSamplerCtx* ls, cons
       LightPoint lp;
       if (!light_point_sample(ls, sc, pb, path, light, u1, u2, &lp)) continue;
       float p_B = pmf * lp.s.pdf;
-      float p_L = 0.0f;
+      float pmf_L = 0.0f;
       if (ls->kind != SAMPLER_BRDF_ORIENTED)
-        p_L = lt_pmf_split(&ls->tree, bp.P, bp.Nq, light, ls->threshold, ls->max_cut) * lp.s.pdf;
+        pmf_L = lt_pmf_split(&ls->tree, bp.P, bp.Nq, light, ls->threshold, ls->max_cut);
+      float p_L = pmf_L * lp.s.pdf;
       float q = p_i * p_B + (1.0f - p_i) * lp.bsdf_pdf;
       float p_Bw = 0.0f;
       if (ls->kind != SAMPLER_BRDF_ORIENTED)
         p_Bw = brdf_light_pmf_weight(ls, pb, path, light) * lp.s.pdf;
-      float w = 1.0f - brdf_weight_tree(ls, p_L, p_Bw, lp.bsdf_pdf, st.y, pb->brdf_share[path]);
+      float w = 1.0f - brdf_weight_tree(ls, p_L, p_Bw, lp.bsdf_pdf, st.y, pb->brdf_share[path],
+                                        brdf_tree_exact(pmf_L, lp.s.is_delta));
       float3 c = beta * lp.f_cos * lp.s.Li * (w * inv_n / q);
       if (is_finite_f(c.x + c.y + c.z) && !(max3(c) > 0.0f)) continue;
       it.origin = lp.origin;
@@ -281,7 +297,8 @@ INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls,
   }
   float p_S = it.extra.x, p_i = it.extra.y;
   float q = p_i * p_B + (1.0f - p_i) * p_S;
-  float w = 1.0f - brdf_weight_tree(ls, p_L, p_Bw, p_S, bp.state.y, pb->brdf_share[path]);
+  // (a probe finds area lights only: never an exact tree estimate)
+  float w = 1.0f - brdf_weight_tree(ls, p_L, p_Bw, p_S, bp.state.y, pb->brdf_share[path], 0);
   item->value = f4_from3(xyz_of(it.value) * Le * (w / q), 0.0f);
   item->extra.w = 1.0f;
 }

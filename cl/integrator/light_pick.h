@@ -43,7 +43,8 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   } else if (HAS_MICROFACET && light_sampler_brdf(ls) && f_w == BRDF_POINT_FLAG) {
     // A glossy point: against its N BRDF-aware samples (brdf_mis.h).
     w = brdf_weight_tree(ls, p_L, brdf_light_pmf_weight(ls, pb, path, light) * lp.s.pdf,
-                         lp.bsdf_pdf, pb->brdf_state[path].y, pb->brdf_share[path]);
+                         lp.bsdf_pdf, pb->brdf_state[path].y, pb->brdf_share[path],
+                         brdf_tree_exact(pmf, lp.s.is_delta));
   } else if (f_w > 0.0f) {
     // MIS against BSDF sampling when the path continues with it (bsdf_pdf 0: delta lights).
     w = power_heuristic(p_L, lp.bsdf_pdf);
@@ -76,7 +77,7 @@ INLINE int light_pick_items(const LightSamplerCtx* ls, const SceneBuffers* sc,
 // measured (docs/performance.md, "Distant lights"). At most MAX_INFINITE_LIGHTS, so that they and
 // the root's own pick fit its LIGHT_PICK_SHADOW_SLOTS.
 INLINE int light_pick_infinite(const LightSamplerCtx* ls, const SceneBuffers* sc,
-                              const PathBuffers* pb, int path, uint seed, GLOBAL ShadowItem* out) {
+                               const PathBuffers* pb, int path, uint seed, GLOBAL ShadowItem* out) {
   int n = 0;
   for (int j = 0; j < ls->infinite_count; ++j) {
     LtRng rng = lt_rng_make(seed, 0x40000000u ^ (uint)j); // apart from codes and leaf lights
@@ -110,9 +111,9 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
     out.z = ls->infinite_count;
     // No other light (the tree is empty), or a glossy point of brdf-oriented, whose BRDF-oriented
     // samples (brdf_mis.h) are its only light samples of the others.
-    int brdf_only = HAS_MICROFACET ? ls->kind == SAMPLER_BRDF_ORIENTED &&
-                                         pb->shade_f[path].w == BRDF_POINT_FLAG
-                                   : 0;
+    int brdf_only =
+        HAS_MICROFACET ? ls->kind == SAMPLER_BRDF_ORIENTED && pb->shade_f[path].w == BRDF_POINT_FLAG
+                       : 0;
     if (ls->light_count <= 0 || brdf_only) return out;
   }
 
