@@ -33,6 +33,7 @@ struct RenderStats {
   double light_tree_seconds = 0.0;
   double upload_seconds = 0.0;  // buffers to the device
   double compile_seconds = 0.0; // OpenCL program build
+  bool program_from_cache = false; // the program was loaded from the program cache
   double render_seconds = 0.0;  // wall time of render()
   uint64_t samples = 0;
   uint64_t shading_points = 0; // surface hits shaded
