@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -105,6 +106,22 @@ TEST_F(ProgramCacheTest, DirectoryDigestSeesEveryFile) {
   EXPECT_NE(d1, d0);
   write(dir_ / "sub" / "c.h", "");
   EXPECT_NE(directory_digest(dir_), d1);
+}
+
+TEST_F(ProgramCacheTest, LeastRecentlyUsedEntriesAreRemoved) {
+  ProgramCache cache(dir_);
+  cache.max_entries = 3;
+  const auto t0 = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(cache.store(key_ + std::to_string(i), binary_));
+    fs::last_write_time(cache.entry_path(key_ + std::to_string(i)), t0 + std::chrono::minutes(i));
+  }
+  ASSERT_TRUE(cache.load(key_ + "0")); // now the most recently used
+  ASSERT_TRUE(cache.store(key_ + "3", binary_));
+  EXPECT_TRUE(cache.load(key_ + "0"));
+  EXPECT_FALSE(cache.load(key_ + "1")) << "the least recently used";
+  EXPECT_TRUE(cache.load(key_ + "2"));
+  EXPECT_TRUE(cache.load(key_ + "3"));
 }
 
 TEST_F(ProgramCacheTest, UnwritableDirectoryIsNotAnError) {

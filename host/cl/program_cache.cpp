@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 #include <system_error>
@@ -116,6 +117,8 @@ std::optional<std::vector<unsigned char>> ProgramCache::load(const std::string& 
   in.remove_prefix(key_size);
   if (!get(in, &size) || !get(in, &digest) || size != in.size() || size == 0) return std::nullopt;
   if (payload_digest(in) != digest) return std::nullopt;
+  // Its use, for prune(): the modification time is the last use.
+  fs::last_write_time(path, fs::file_time_type::clock::now(), ec);
   return std::vector<unsigned char>(in.begin(), in.end());
 }
 
@@ -144,10 +147,24 @@ bool ProgramCache::store(const std::string& key, const std::vector<unsigned char
     }
   }
   fs::rename(tmp, path, ec);
-  if (!ec) return true;
-  std::error_code ignored;
-  fs::remove(tmp, ignored);
-  return false;
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    return false;
+  }
+  prune();
+  return true;
+}
+
+void ProgramCache::prune() const {
+  std::error_code ec;
+  std::vector<std::pair<fs::file_time_type, fs::path>> entries;
+  for (auto it = fs::directory_iterator(dir_, ec); !ec && it != fs::end(it); it.increment(ec))
+    if (it->path().extension() == ".bin") entries.emplace_back(it->last_write_time(ec), it->path());
+  if (entries.size() <= max_entries) return;
+  std::sort(entries.begin(), entries.end(), std::greater<>());
+  for (size_t i = max_entries; i < entries.size(); ++i)
+    fs::remove(entries[i].second, ec);
 }
 
 } // namespace canopy

@@ -47,10 +47,16 @@ public:
   // written for another key).
   std::optional<std::vector<unsigned char>> load(const std::string& key) const;
   // Stores `binary` under `key` (written to a temporary file, then renamed: a concurrent reader
-  // sees the old entry or the new one). Returns false if it could not be written.
+  // sees the old entry or the new one), then removes the least recently used entries beyond
+  // `max_entries` (each kernel source change leaves entries nothing will load again). Returns
+  // false if it could not be written.
   bool store(const std::string& key, const std::vector<unsigned char>& binary) const;
 
+  size_t max_entries = 64; // a few scenes' programs, each 0.3-1 MB
+
 private:
+  void prune() const;
+
   std::filesystem::path dir_;
 };
 
