@@ -33,7 +33,6 @@ struct RenderStats {
   double light_tree_seconds = 0.0;
   double upload_seconds = 0.0;  // buffers to the device
   double compile_seconds = 0.0; // OpenCL program build
-  bool program_from_cache = false; // the program was loaded from the program cache
   double render_seconds = 0.0;  // wall time of render()
   uint64_t samples = 0;
   uint64_t shading_points = 0; // surface hits shaded
@@ -47,6 +46,8 @@ struct RenderStats {
   uint64_t medium_segments = 0, medium_shadow_rays = 0;
   std::vector<uint64_t> cut_size_histogram; // shading points by number of cut members
   std::string kernel_options;               // the -D options the kernels were compiled with
+  // The program was loaded from the program cache (host/cl/program_cache.h), not compiled.
+  bool program_from_cache = false;
   uint64_t nonfinite_samples = 0; // samples that were not finite and were recorded as zero
   // Pixels whose resolved value (film mean) lies beyond the float32 range of the output image:
   // Film::mean() writes them as +-FLT_MAX, never as Inf.
