@@ -3,6 +3,7 @@
 // that the first render finds them there. The build runs it on scenes/default.json. The cache
 // is only an optimisation: a failure is reported and the exit status is still 0 (the render then
 // compiles on first use).
+#include "cl/program_cache.h"
 #include "cl/runtime.h"
 #include "light_tree/light_sampler_names.h"
 #include "render/auto_sampler.h"
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <exception>
 #include <optional>
+#include <string>
 #include <vector>
 
 using namespace canopy;
@@ -50,7 +52,9 @@ void precompile(ClRuntime& rt, const char* path) {
       renderer.emplace(rt, scene, o); // compiles (or loads) the first program
     else
       renderer->set_light_sampler(o);
-  std::printf("canopy-precompile: %s: %zu programs in the cache (%.1f s)\n", path, variants.size(),
+  const std::string dir = program_cache_dir().string();
+  std::printf("canopy-precompile: %s: %zu programs in %s (%.1f s)\n", path, variants.size(),
+              dir.empty() ? "no cache (CANOPY_CACHE_DIR is empty)" : dir.c_str(),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
