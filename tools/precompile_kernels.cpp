@@ -53,8 +53,8 @@ void precompile(ClRuntime& rt, const char* path) {
     else
       renderer->set_light_sampler(o);
   const std::string dir = program_cache_dir().string();
-  std::printf("canopy-precompile: %s: %zu programs in %s (%.1f s)\n", path, variants.size(),
-              dir.empty() ? "no cache (CANOPY_CACHE_DIR is empty)" : dir.c_str(),
+  std::printf("canopy-precompile: %s: %zu programs %s%s (%.1f s)\n", path, variants.size(),
+              dir.empty() ? "built, not cached: CANOPY_CACHE_DIR is empty" : "in ", dir.c_str(),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
