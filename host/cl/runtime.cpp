@@ -1,11 +1,14 @@
 #include "cl/runtime.h"
 
+#include "cl/program_cache.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <unistd.h>
 
@@ -202,28 +205,28 @@ std::string ClRuntime::device_name() const {
   return device_.getInfo<CL_DEVICE_NAME>();
 }
 
-cl::Program ClRuntime::build_program(const std::vector<std::string>& files,
-                                     const std::string& options) const {
-  std::filesystem::path dir = kernel_dir();
-  std::string source;
-  for (const auto& f : files)
-    source += read_text(dir / f) + "\n";
-  return build_program_source(source, options);
+std::string ClRuntime::device_signature() const {
+  cl::Platform platform(device_.getInfo<CL_DEVICE_PLATFORM>());
+  return fmt::format("device {}\ndevice version {}\ndriver {}\nplatform {}\n",
+                     device_.getInfo<CL_DEVICE_NAME>(), device_.getInfo<CL_DEVICE_VERSION>(),
+                     device_.getInfo<CL_DRIVER_VERSION>(), platform.getInfo<CL_PLATFORM_VERSION>());
 }
 
-cl::Program ClRuntime::build_program_source(const std::string& source,
-                                            const std::string& options) const {
-  std::filesystem::path dir = kernel_dir();
-  cl::Program program(context_, source);
+std::string ClRuntime::build_options(const std::string& options) const {
   // PoCL passes the option string to clang verbatim: no quotes, so escape spaces instead.
   std::string inc;
-  for (char c : dir.string())
+  for (char c : kernel_dir().string())
     inc += c == ' ' ? std::string("\\ ") : std::string(1, c);
   std::string opts = fmt::format("-I {} -cl-std=CL1.2 -cl-kernel-arg-info {}", inc, options);
   // The tests build kernels with -Werror (a warning in a kernel is a defect like one in the host
   // code); users' builds stay tolerant of whatever a newer PoCL clang may warn about.
   if (const char* w = std::getenv("CANOPY_KERNEL_WERROR"); w && *w && std::string(w) != "0")
     opts += " -Werror";
+  return opts;
+}
+
+cl::Program ClRuntime::build_from_source(const std::string& source, const std::string& opts) const {
+  cl::Program program(context_, source);
   try {
     program.build({device_}, opts.c_str());
   } catch (const cl::Error&) {
@@ -231,6 +234,44 @@ cl::Program ClRuntime::build_program_source(const std::string& source,
     throw ClError(fmt::format("OpenCL program build failed (options: {}):\n{}", opts, log));
   }
   return program;
+}
+
+cl::Program ClRuntime::build_program(const std::vector<std::string>& files,
+                                     const std::string& options, bool* from_cache) const {
+  std::filesystem::path dir = kernel_dir();
+  std::string source;
+  for (const auto& f : files)
+    source += read_text(dir / f) + "\n";
+  const std::string opts = build_options(options);
+  if (from_cache) *from_cache = false;
+  const std::filesystem::path cache_dir = program_cache_dir();
+  if (cache_dir.empty()) return build_from_source(source, opts);
+
+  // The headers are part of the key: the files include them from the kernel directory.
+  Digest text;
+  text.add(source);
+  const std::string key = fmt::format("{}options {}\nsource {}\nheaders {}\n", device_signature(),
+                                      opts, text.hex(), directory_digest(dir));
+  const ProgramCache cache(cache_dir);
+  if (std::optional<std::vector<unsigned char>> binary = cache.load(key)) {
+    try {
+      cl::Program program(context_, {device_}, cl::Program::Binaries{*binary});
+      program.build({device_}, opts.c_str());
+      if (from_cache) *from_cache = true;
+      return program;
+    } catch (const cl::Error&) { // an entry the driver refuses: rebuilt and replaced below
+    }
+  }
+  cl::Program program = build_from_source(source, opts);
+  // Asking for the binary makes PoCL compile every kernel's work-group function now.
+  std::vector<std::vector<unsigned char>> binaries = program.getInfo<CL_PROGRAM_BINARIES>();
+  if (binaries.size() == 1) cache.store(key, binaries[0]);
+  return program;
+}
+
+cl::Program ClRuntime::build_program_source(const std::string& source,
+                                            const std::string& options) const {
+  return build_from_source(source, build_options(options));
 }
 
 cl::Event enqueue_1d(cl::CommandQueue& q, const cl::Kernel& k, size_t n, size_t local) {

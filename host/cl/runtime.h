@@ -49,9 +49,12 @@ public:
 
   // Builds a program from the given files (relative to kernel_dir()) with "-I <kernel_dir>",
   // "-cl-kernel-arg-info" (kernel arguments are bound by name, host/cl/kernel_args.h) and `options`
-  // appended. Throws ClError holding the build log on failure.
-  cl::Program build_program(const std::vector<std::string>& files,
-                            const std::string& options = "") const;
+  // appended. Throws ClError holding the build log on failure. The program is loaded from the
+  // program cache (host/cl/program_cache.h) when it holds it; otherwise it is compiled, every
+  // kernel included (PoCL compiles a kernel's work-group function when asked for the binary, not
+  // at its first launch), and stored there. `from_cache`, if given, tells which happened.
+  cl::Program build_program(const std::vector<std::string>& files, const std::string& options = "",
+                            bool* from_cache = nullptr) const;
   // The same for source text (test and benchmark kernels that include headers from cl/).
   cl::Program build_program_source(const std::string& source,
                                    const std::string& options = "") const;
@@ -60,16 +63,22 @@ public:
   const cl::Device& device() const { return device_; }
   cl::CommandQueue& queue() { return queue_; }
   std::string device_name() const;
+  // What a program binary for this device depends on besides its source and options: the device,
+  // its OpenCL version and its driver's (PoCL's) version.
+  std::string device_signature() const;
 
 private:
+  std::string build_options(const std::string& options) const;
+  cl::Program build_from_source(const std::string& source, const std::string& opts) const;
+
   cl::Context context_;
   cl::Device device_;
   cl::CommandQueue queue_;
 };
 
 // Launch helper: global size rounded up to a multiple of `local`; kernels ignore the padding items
-// (`if (i >= count) return`). Keep `local` fixed: PoCL compiles a work-group function per local
-// size, and letting it choose one per launch size recompiles kernels in the middle of a render.
+// (`if (i >= count) return`). With POCL_WORK_GROUP_SPECIALIZATION=0 (set by ClRuntime) PoCL
+// compiles one generic work-group function per kernel, used for every local size.
 constexpr size_t kDefaultLocalSize = 64;
 cl::Event enqueue_1d(cl::CommandQueue& q, const cl::Kernel& k, size_t n,
                      size_t local = kDefaultLocalSize);

@@ -277,8 +277,9 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     return out;
   }
 
-  // The exploration: per candidate, one untimed pass (PoCL compiles a kernel at its first launch,
-  // and the first render touches the scene's memory), then `renders` timed renders of its passes.
+  // The exploration: per candidate, one untimed pass (PoCL loads a kernel at its first launch,
+  // and the first render allocates the wave's buffers and touches the scene's memory), then
+  // `renders` timed renders of its passes.
   // The faster gives the time per pass (robust to a moment of other load on the machine).
   int next = settings.first_sample;
   std::vector<Film> films;

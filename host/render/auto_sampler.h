@@ -78,7 +78,7 @@ std::vector<PilotResult> auto_candidates(const RendererOptions& base);
 
 // How many passes each candidate's two timed exploration renders hold, for a render of `spp`
 // samples per pixel: `wave_passes` (one per candidate) fills one of its waves. A candidate renders
-// 1 untimed pass (PoCL compiles a kernel at its first launch) and then up to two timed renders of
+// 1 untimed pass (the first launches and allocations) and then up to two timed renders of
 // those passes; the exploration takes at most 60% of the samples (or 2 per candidate, the least
 // that measures a variance, if that is more) and leaves at least one for the chosen candidate.
 // Returns the passes per timed render and sets `renders` (1 or 2); empty when spp is too small to

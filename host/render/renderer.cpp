@@ -185,7 +185,7 @@ void Renderer::compile_kernels() {
   // vacuum: every path passes unchanged, so forcing the feature on changes no image).
   volume_stages_ = features.medium;
   stats_.kernel_options = features.build_options();
-  program_ = rt_.build_program(kKernelFiles, stats_.kernel_options);
+  program_ = rt_.build_program(kKernelFiles, stats_.kernel_options, &stats_.program_from_cache);
   stats_.compile_seconds = seconds_since(t0);
 }
 
@@ -231,6 +231,7 @@ void Renderer::reset_render_stats() {
   fresh.light_tree_seconds = stats_.light_tree_seconds;
   fresh.upload_seconds = stats_.upload_seconds;
   fresh.compile_seconds = stats_.compile_seconds;
+  fresh.program_from_cache = stats_.program_from_cache;
   fresh.kernel_options = stats_.kernel_options;
   fresh.emission_exponent = stats_.emission_exponent;
   fresh.cut_size_histogram.assign(kCutBins, 0);

@@ -46,6 +46,8 @@ struct RenderStats {
   uint64_t medium_segments = 0, medium_shadow_rays = 0;
   std::vector<uint64_t> cut_size_histogram; // shading points by number of cut members
   std::string kernel_options;               // the -D options the kernels were compiled with
+  // The program was loaded from the program cache (host/cl/program_cache.h), not compiled.
+  bool program_from_cache = false;
   uint64_t nonfinite_samples = 0; // samples that were not finite and were recorded as zero
   // Pixels whose resolved value (film mean) lies beyond the float32 range of the output image:
   // Film::mean() writes them as +-FLT_MAX, never as Inf.
