@@ -343,8 +343,8 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   Film rest = renderer.render(rs);
   // A candidate's weight at a pixel: 1 where another candidate's camera rays saw an emitter there
   // (that pixel's noise is mostly the emitter's edge, the same for every candidate, and unequal
-  // weights on equally good samples add variance), else its weight in the pixel's half. Both
-  // depend on other samples than the ones they weight.
+  // weights on equally good samples add variance), unless it missed its tail; else its weight in
+  // the pixel's half. Both depend on other samples than the ones they weight.
   const size_t npixels = rest.sum.size();
   std::vector<std::vector<double>> wc(cand.size(), std::vector<double>(npixels));
   std::vector<double> w(npixels, double(settings.spp));
@@ -353,7 +353,8 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       bool edge = false;
       for (size_t d = 0; d < cand.size(); ++d)
         edge = edge || (d != i && films[d].counts[p].z > 0.0);
-      wc[i][p] = edge ? 1.0 : cand[i].weight[half_of(rest, p)];
+      const double wh = cand[i].weight[half_of(rest, p)];
+      wc[i][p] = edge && wh > 0.0 ? 1.0 : wh; // a missed tail weighs nothing anywhere
       w[p] -= wc[i][p] * double(cand[i].samples);
     }
   for (double& x : w)
