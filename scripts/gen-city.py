@@ -3,7 +3,7 @@
 docs/results.md (Conty Estevez & Kulla 2018, Fig. 1 and 14, at a size that renders here).
 
     python3 scripts/gen-city.py            # rewrites both files (deterministic)
-    python3 scripts/gen-city.py --fog      # also writes scenes/city-fog.json (issue 13)
+    python3 scripts/gen-city.py --fog      # also writes scenes/city-fog.json
 
 --fog: scenes/city-fog.json is city.json with a homogeneous medium added and nothing else
 changed (the paper's Fig. 1 renders the city in participating media): a layer of thin ground fog,

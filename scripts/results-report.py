@@ -34,10 +34,10 @@ SCENES = [
     ("city", "Procedural city, about 3 x 10^5 lights (Conty Estevez & Kulla 2018, Fig. 1, 14)"),
     ("mesh-light", "Toroidal mesh light, 5,120 emissive triangles (Conty Estevez & Kulla 2018, "
                    "Fig. 6, 15, 16)"),
-    ("spiral-fog", "The spiral in a homogeneous medium (issue 13)"),
-    ("city-fog", "The city in fog (issue 13)"),
+    ("spiral-fog", "The spiral in a homogeneous medium"),
+    ("city-fog", "The city in fog"),
     ("outdoor", "Late afternoon: a sun, an image sky, 400 garden lamps, textured ground and a "
-                "brushed gold box (issue 22)"),
+                "brushed gold box"),
 ]
 TAGS = [("d1", "Direct light (`--max-depth 1`)"), ("dfull", "Full paths (the scene's depth)")]
 CLOSE = 0.10  # within 10% of the best's efficiency

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end test of the Slurm scripts on a one-node cluster started on this machine (issue 23):
+# End-to-end test of the Slurm scripts on a one-node cluster started on this machine:
 # munged, slurmctld and slurmd run as root from a private directory (their own key, socket,
 # config, state and ports: nothing of the system's is touched), submit.sh renders SCENE as an
 # array of 4 sample ranges plus the merge job, and the merged image must equal a single-process
