@@ -15,9 +15,10 @@
 #
 # Environment: SCENES; BUILD, CANOPY, SKIP_BUILD; EQUAL_TIME (seconds per render) and REF_TIME
 # (reference seconds) override the table's; SEEDS (8: fewer is refused unless ALLOW_FEW_SEEDS=1);
-# SAMPLERS (the configurations compared); DEPTHS ("full 1": the scene's depth, then direct light);
-# WORK (out/results: references and logs), DOCS (docs/results: CSVs, small PNGs) and REPORT
-# (docs/results.md) move the outputs; REUSE_REFERENCE=1 keeps a reference already in $WORK (with
+# PROCESS_RUNS (whole-process runs per configuration, 3); SAMPLERS (the configurations
+# compared); DEPTHS ("full 1": the scene's depth, then direct light); WORK (out/results:
+# references and logs), DOCS (docs/results: CSVs, small PNGs) and REPORT (docs/results.md) move
+# the outputs; REUSE_REFERENCE=1 keeps a reference already in $WORK (with
 # its REF.mask.png; converge refuses one of another depth or film size, the sampler is the
 # caller's responsibility) instead of rendering it again.
 #
@@ -29,6 +30,11 @@
 # of each image's squared error held by its top 0.1% of pixels (mean and max over seeds) and the
 # worst pixel's squared error; all over every pixel and over the pixels whose camera rays do not
 # hit an emitter directly (the reference's emitter mask).
+#
+# Whole process. Then scripts/process-seconds.py times `canopy render` as a fresh process at each
+# configuration's spp (PROCESS_RUNS runs, 3 by default, after an untimed one that fills the kernel
+# cache): start-up, auto's exploration and writing the images included. The report's whole-process
+# efficiency is 1 / (mean MSE x mean process seconds): the seconds a user waits.
 #
 # References. Rendered by converge (--reference-time R: spp from a timing render) as two halves
 # with independent seeds; their difference gives the reference's error floor, MSE_floor =
@@ -153,6 +159,12 @@ for name in $SCENES; do
       echo "# (REUSE_REFERENCE: $ref is from an earlier run of this script)" >>"$DOCS/$name-$tag-commands.txt"
     fi
     "${cmd[@]}" | tee "$WORK/$name-$tag-converge.txt"
+    # The whole process at the chosen spp: start-up and auto's exploration included.
+    depth_arg=()
+    if [ ${#depth_opt[@]} -gt 0 ]; then depth_arg=(--max-depth "$depth"); fi
+    python3 scripts/process-seconds.py --canopy "$CANOPY" --scene "$scene" --film-scale "$scale" \
+      "${depth_arg[@]}" --points "$DOCS/$name-$tag-points.csv" --out "$DOCS/$name-$tag-process.csv" \
+      --runs "${PROCESS_RUNS:-3}"
     # The reference's metadata (sampler, spp, seconds, error floors), for the report.
     "$CANOPY" compare "$ref" "$ref" --json >"$DOCS/$name-$tag-reference.json"
     if [ "$tag" = dfull ]; then

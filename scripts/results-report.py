@@ -98,6 +98,19 @@ def usable(row):
     return row.get("resolved_ne", "") != "0" and math.isfinite(num(row, "efficiency_ne"))
 
 
+def whole_process(row, process, suffix):
+    """1 / (mean MSE x mean process seconds) and its 95% interval from the MSE's (the seeds
+    resampled; the process seconds' spread over runs is small beside it), or NaNs without a
+    process time. suffix: '' (all pixels) or '_ne'."""
+    p = process.get(row["sampler"])
+    if not p:
+        return math.nan, math.nan, math.nan
+    w = num(p, "wall_seconds")
+    mse = num(row, "mse" + suffix)
+    lo, hi = num(row, "mse_lo" + suffix), num(row, "mse_hi" + suffix)
+    return 1 / (mse * w), 1 / (hi * w), 1 / (lo * w)
+
+
 def marks(rows):
     """Per configuration label: 'best', 'close' (within 10% or overlapping interval), 'no' or
     'unresolved', by the non-emitter efficiency."""
@@ -135,21 +148,25 @@ def reference_line(docs, name, tag):
             f"pixels.")
 
 
-def table(rows):
+def table(rows, process):
     m, best = marks(rows)
     lines = [
         "| configuration | spp | seconds | MSE non-emitter [95% CI] | efficiency non-emitter "
-        "[95% CI] | MSE all [95% CI] | efficiency all [95% CI] | top-0.1% share non-emitter "
+        "[95% CI] | MSE all [95% CI] | efficiency all [95% CI] | process seconds | whole-process "
+        "efficiency non-emitter / all | top-0.1% share non-emitter "
         "(mean / max) | top-0.1% share all (mean / max) | worst pixel (non-emitter / all) | "
         "resolved (non-emitter / all) | verdict |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         verdict = m.get(r["sampler"], "")
         label = f"**{r['sampler']}**" if verdict == "best" else r["sampler"]
+        p = process.get(r["sampler"])
+        wall = f"{num(p, 'wall_seconds'):.2f}" if p else "-"
         lines.append(
             f"| {label} | {r['spp']} | {num(r, 'seconds'):.3f} | {ci(r, 'mse_ne')} | "
-            f"{ci(r, 'efficiency_ne')} | {ci(r, 'mse')} | {ci(r, 'efficiency')} | "
+            f"{ci(r, 'efficiency_ne')} | {ci(r, 'mse')} | {ci(r, 'efficiency')} | {wall} | "
+            f"{fe(whole_process(r, process, '_ne')[0])} / {fe(whole_process(r, process, '')[0])} | "
             f"{num(r, 'top_share_mean_ne'):.2f} / {num(r, 'top_share_max_ne'):.2f} | "
             f"{num(r, 'top_share_mean'):.2f} / {num(r, 'top_share_max'):.2f} | "
             f"{fe(num(r, 'worst_pixel_max_ne'))} / {fe(num(r, 'worst_pixel_max'))} | "
@@ -192,11 +209,78 @@ def default_section(text_path, candidates, table_names):
     return out + [""]
 
 
+FIXED_EXCLUDED = ("auto",)  # the default is judged against the fixed configurations
+
+
+def wall_clock_rows(docs, names):
+    """Per table of one budget: the default's whole-process efficiency against the best fixed
+    configuration's, over all pixels (the verdict) and over the non-emitter pixels."""
+    out = []
+    for name in names:
+        for tag, _ in TAGS:
+            rows = read_csv(os.path.join(docs, f"{name}-{tag}-points.csv"))
+            process = {p["sampler"]: p for p in
+                       read_csv(os.path.join(docs, f"{name}-{tag}-process.csv"))}
+            auto = next((r for r in rows if r["sampler"] == "auto"), None)
+            if not rows or not process or not auto or "auto" not in process:
+                continue
+            depth = rows[0].get("max_depth", "?")
+            cells = [name, "depth 1" if tag == "d1" else f"depth {depth}"]
+            for suffix in ("", "_ne"):
+                fixed = [r for r in rows if r["sampler"] not in FIXED_EXCLUDED and
+                         r.get("resolved" + suffix, "") != "0" and r["sampler"] in process]
+                a, alo, ahi = whole_process(auto, process, suffix)
+                if not fixed or auto.get("resolved" + suffix, "") == "0":
+                    cells += ["unresolved", "-", "-", "-"]
+                    continue
+                best = max(fixed, key=lambda r: whole_process(r, process, suffix)[0])
+                b, blo, _ = whole_process(best, process, suffix)
+                if a >= (1 - CLOSE) * b:
+                    verdict = "within 10%" if a < b else "best"
+                elif ahi >= blo:
+                    verdict = "overlaps"
+                else:
+                    verdict = f"{b / a:.2g}x less"
+                cells += [best["sampler"], f"{a / b:.2f}",
+                          f"{fe(a)} [{fe(alo)}, {fe(ahi)}]", verdict]
+            cells.insert(2, f"{num(process['auto'], 'wall_seconds'):.2f}")
+            out.append("| " + " | ".join(cells) + " |")
+    return out
+
+
+def wall_clock_section(budgets, names):
+    out = ["## At the user's wall clock", "",
+           "Whole-process efficiency = 1 / (mean MSE x mean seconds of the whole `canopy render` "
+           "process at the configuration's spp): start-up (scene load, light tree, kernel "
+           "programs from the cache), auto's exploration and writing the images included "
+           "(scripts/process-seconds.py, 3 runs per configuration after one that fills the kernel "
+           "cache). The default, `auto`, against the fixed configuration of the highest "
+           "whole-process efficiency, over all pixels (what the user looks at) and over the "
+           "non-emitter pixels; auto / best is the ratio of their efficiencies (the default's 95% "
+           "interval comes from its MSE's). The rule: within 10% of the best or overlapping "
+           "intervals, over all pixels.", ""]
+    for label, docs in budgets:
+        rows = wall_clock_rows(docs, names)
+        if not rows:
+            continue
+        out += [f"### {label}", "",
+                "| scene | table | auto process seconds | best fixed, all pixels | auto / best | "
+                "auto whole-process efficiency [95% CI] | verdict | best fixed, non-emitter | "
+                "auto / best | auto [95% CI] | verdict |",
+                "|---|---|---|---|---|---|---|---|---|---|---|"] + rows + [""]
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--docs", default="docs/results")
     ap.add_argument("--command", default="./scripts/make-results.sh")
     ap.add_argument("--note", default="", help="a line on the run (scenes, budgets, seeds)")
+    ap.add_argument("--budget", action="append", default=[],
+                    help="LABEL=DIR: another budget's converge and process CSVs, for the "
+                         "wall-clock section (the first is --docs)")
+    ap.add_argument("--budget-label", default="1 s per render",
+                    help="the label of --docs' budget in the wall-clock section")
     ap.add_argument("--default-text", default="scripts/results-default.md",
                     help="the reasoning behind the default estimator (Markdown), quoted as is")
     args = ap.parse_args()
@@ -252,7 +336,9 @@ def main():
             if not rows:
                 continue
             depth = rows[0].get("max_depth", "?")
-            lines, m, best = table(rows)
+            process = {p["sampler"]: p for p in
+                       read_csv(os.path.join(args.docs, f"{name}-{tag}-process.csv"))}
+            lines, m, best = table(rows, process)
             cmd_path = os.path.join(args.docs, f"{name}-{tag}-commands.txt")
             cmd = open(cmd_path).read().strip() if os.path.exists(cmd_path) else ""
             tables.append((tag, title, depth, lines, m, best, cmd, rows))
@@ -289,6 +375,8 @@ def main():
                            f"{', '.join(close) or '-'} | {', '.join(unres) or '-'} |")
         sections += sec
     out += ["## Summary", ""] + summary + [""]
+    budgets = [(args.budget_label, args.docs)] + [tuple(b.split("=", 1)) for b in args.budget]
+    out += wall_clock_section(budgets, [n for n, _ in SCENES])
     if table_names:
         out += default_section(args.default_text, candidates, table_names)
     out += sections

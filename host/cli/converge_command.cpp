@@ -672,10 +672,7 @@ std::string resolved_text(int resolved) {
 int run_converge(const ConvergeArgs& a) {
   auto t_start = Clock::now();
   Scene base = load_scene(a.scene);
-  if (a.film_scale != 1.0) {
-    base.film.width = std::max(1, int(std::lround(base.film.width * a.film_scale)));
-    base.film.height = std::max(1, int(std::lround(base.film.height * a.film_scale)));
-  }
+  if (a.film_scale != 1.0) scale_film(base.film, a.film_scale);
   if (a.max_depth > 0) base.integrator.max_depth = a.max_depth;
   std::vector<SamplerConfig> configs = parse_configs(a.samplers, base.integrator);
   if (a.spp_factor < 2) throw SceneError("--spp-factor: must be >= 2");

@@ -59,6 +59,7 @@ struct RenderArgs {
   bool brdf_equal = false;
   std::optional<std::string> volume_importance;
   std::optional<std::string> samples, crop; // "A:B", "x0,y0,x1,y1"
+  std::optional<double> film_scale;
   std::string out, png, device, stats_json, heatmap, emitter_mask;
   bool stats = false;
   bool quiet = false;
@@ -264,6 +265,13 @@ int run_render(const RenderArgs& args) {
     auto [a, b] = parse_sample_range(*args.samples);
     first_sample = a;
     scene.integrator.spp = b - a;
+  }
+  // Before --crop, whose pixels are those of the scaled film.
+  if (args.film_scale) {
+    scale_film(scene.film, *args.film_scale);
+    if (scene.film.width > kMaxFilmSide || scene.film.height > kMaxFilmSide)
+      throw SceneError(fmt::format("--film-scale: {}x{} exceeds the largest film side, {}",
+                                   scene.film.width, scene.film.height, kMaxFilmSide));
   }
   PixelWindow window;
   if (args.crop) window = parse_crop(*args.crop, scene.film.width, scene.film.height);
@@ -543,6 +551,10 @@ int main(int argc, char** argv) {
   render->add_option("--crop", rargs.crop,
                      "x0,y0,x1,y1 renders the film's pixels [x0, x1) x [y0, y1) only, the same as "
                      "in the full render (a tile for `canopy merge`)");
+  render
+      ->add_option("--film-scale", rargs.film_scale,
+                   "Scale the scene's film resolution, e.g. 0.25 for a preview (before --crop)")
+      ->check(CLI::Range(0.01, 4.0));
   render->add_flag("--quiet", rargs.quiet, "No progress report");
   render->add_flag("--strict", rargs.strict,
                    "Scene warnings (pbrt constructs not read, unknown parameters) are errors");

@@ -7,7 +7,9 @@
 #include "light_tree/split.h"               // cl/: LT_DEFAULT_SPLIT_THRESHOLD
 #include "types.h"                          // cl/types.h: Light, Material (device layouts)
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <stdexcept>
@@ -83,6 +85,13 @@ struct FilmSettings {
   // Every pixel is multiplied by this before it is written (pbrt's Film "scale" x iso / 100).
   float image_scale = 1.0f;
 };
+
+// The film at `scale` times its resolution (a preview, or the scaled films of docs/results.md):
+// each side rounded, at least 1 pixel. The camera keeps its field of view.
+inline void scale_film(FilmSettings& f, double scale) {
+  f.width = std::max(1, int(std::lround(f.width * scale)));
+  f.height = std::max(1, int(std::lround(f.height * scale)));
+}
 
 // Defaults show the renderer at its best: "auto", a pilot render that picks power, tree or brdf-mis
 // (with splitting at the measured threshold) per scene (render/auto_sampler.h), within 10% of the
