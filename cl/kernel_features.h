@@ -18,6 +18,7 @@
 #define HAS_PRIM_DISK 1
 #define HAS_MATERIAL_CONDUCTOR 1
 #define HAS_MATERIAL_PLASTIC 1
+#define HAS_MATERIAL_DIELECTRIC 1
 #define HAS_MEDIUM 1
 #define HAS_TEXTURES 1
 #endif
@@ -34,6 +35,10 @@
 #define IS_MATERIAL(m, T) (HAS_##T ? (m)->type == T : 0)
 // GGX code (cl/bsdf/microfacet.h) is compiled only for scenes with a glossy material.
 #define HAS_MICROFACET (HAS_MATERIAL_CONDUCTOR || HAS_MATERIAL_PLASTIC)
+// One feature for both smooth dielectrics (cl/bsdf/dielectric.h).
+#define HAS_MATERIAL_THIN_DIELECTRIC HAS_MATERIAL_DIELECTRIC
+// Dielectric Fresnel (cl/bsdf/fresnel.h): the glossy materials and glass.
+#define HAS_FRESNEL (HAS_MICROFACET || HAS_MATERIAL_DIELECTRIC)
 // Lights at infinity (cl/types.h): distant or environment lights.
 #define HAS_INFINITE_LIGHT (HAS_LIGHT_DISTANT || HAS_LIGHT_ENVIRONMENT)
 

@@ -47,10 +47,10 @@ typedef struct Light {
   float4 e1;
   // quad: edge 2; triangle: v2 - v0; spot: 1 - cos of the cone half-angle (x) and of the
   // falloff-start half-angle (y), both from 2 sin^2(angle / 2) in double (the falloff works in
-  // 1 - cos, exact for narrow cones, cl/lights/light_sample.h); cos of the falloff start (w). disk: unit
-  // tangent t2 = n x t1 (xyz), w unused.
+  // 1 - cos, exact for narrow cones, cl/lights/light_sample.h); cos of the falloff start (w). disk:
+  // unit tangent t2 = n x t1 (xyz), w unused.
   float4 e2;
-  float4 n;        // quad/triangle/disk: unit normal of the emitting face (xyz), area (w)
+  float4 n; // quad/triangle/disk: unit normal of the emitting face (xyz), area (w)
   // rgb: intensity (point/spot), radiance (area lights), irradiance (distant), radiance scale
   // (environment)
   float4 emission;
@@ -66,13 +66,19 @@ typedef struct Light {
 #define MATERIAL_DIFFUSE 0   // Lambertian: albedo / pi
 #define MATERIAL_CONDUCTOR 1 // GGX microfacet with the exact conductor Fresnel of eta + i k
 #define MATERIAL_PLASTIC 2   // albedo / pi + specular * GGX with dielectric Fresnel (pbrt-v3)
+// Smooth glass (pbrt-v4's dielectric with roughness 0): Fresnel reflection and refraction of
+// index `ior`, both delta lobes. The thin one is a sheet: rays pass straight through it, with the
+// reflectance of its two faces and every inter-reflection between them (pbrt-v4's thindielectric).
+#define MATERIAL_DIELECTRIC 3
+#define MATERIAL_THIN_DIELECTRIC 4
 
 typedef struct Material {
   float4 albedo;   // diffuse, plastic: diffuse reflectance rgb in [0,1]
   float4 specular; // plastic: specular scale rgb; conductor: eta (real part of the index) rgb
   float4 k;        // conductor: k (imaginary part of the index) rgb
   float alpha;     // conductor, plastic: GGX alpha = roughness^2 (0: perfect specular)
-  float ior;       // plastic: index of refraction of the coat
+  float ior;       // plastic: index of refraction of the coat; dielectrics: their index (the
+                   // scene's, inside over outside; shade_surface inverts it for a ray from inside)
   int type;        // MATERIAL_*
   // Image textures (HAS_TEXTURES; cl/texture.h): 1 + the index into the scene's textures of the
   // texture that replaces albedo (rgb) and alpha (a float texture mapped to alpha, Texture::map);

@@ -1,6 +1,7 @@
 // The BSDFs of cl/bsdf/ on PoCL against the host: a test kernel runs bsdf_eval, bsdf_pdf,
 // bsdf_sample and bsdf_has_smooth_lobe for every material type (diffuse; conductor and plastic
-// from a perfect mirror to alpha = 1; grazing and random directions) on inputs the host evaluates
+// from a perfect mirror to alpha = 1; glass from either side, index-matched, and a thin sheet;
+// grazing and random directions) on inputs the host evaluates
 // identically, so the host's statistical tests (test_bsdf.cpp) cover the device too. The program
 // is built with every feature on (the default) and with each material feature alone, which also
 // proves the dispatch compiles when GGX code is left out (a diffuse-only kernel).
@@ -173,6 +174,7 @@ void run_probes(ClRuntime& rt, const std::string& options, const std::vector<Mat
       EXPECT_EQ(dpdf, 0.0f) << what;
       expect_rel(dweight.x, s.weight.x, 2e-5f, what + " delta weight");
       expect_rel(dweight.z, s.weight.z, 2e-5f, what + " delta weight");
+      ++compared_samples;
       continue;
     }
     // The device's pdf and weight against the host's functions at the device's direction.
@@ -197,13 +199,19 @@ std::vector<Material> all_materials() {
     v.push_back(conductor(a));
     v.push_back(plastic(a));
   }
+  // Glass seen from outside, from inside (beyond the critical angle: total internal reflection),
+  // index-matched (it passes everything straight on), and a thin sheet.
+  for (float ior : {1.5f, 1.0f / 1.5f, 1.0f, 2.4f})
+    v.push_back(make_dielectric(ior));
+  v.push_back(make_dielectric(1.5f, true));
   return v;
 }
 
-std::string features(bool conductor_on, bool plastic_on) {
+std::string features(bool conductor_on, bool plastic_on, bool dielectric_on = false) {
   KernelFeatures f;
   f.material_conductor = conductor_on;
   f.material_plastic = plastic_on;
+  f.material_dielectric = dielectric_on;
   return f.build_options();
 }
 
@@ -218,10 +226,14 @@ TEST(KernelBsdf, EveryMaterialMatchesHost) {
 // a feature only removes code for types the scene does not have).
 TEST(KernelBsdf, SpecialisedKernelsMatchHost) {
   ClRuntime rt;
-  std::vector<Material> conductors, plastics;
-  for (const Material& m : all_materials())
-    (m.type == MATERIAL_CONDUCTOR ? conductors : plastics).push_back(m);
+  std::vector<Material> conductors, plastics, glass;
+  for (const Material& m : all_materials()) {
+    if (m.type == MATERIAL_CONDUCTOR) conductors.push_back(m);
+    if (m.type == MATERIAL_PLASTIC) plastics.push_back(m);
+    if (m.type == MATERIAL_DIELECTRIC || m.type == MATERIAL_THIN_DIELECTRIC) glass.push_back(m);
+  }
   run_probes(rt, features(false, false), {diffuse()}, 2); // diffuse only: no GGX code
   run_probes(rt, features(true, false), conductors, 3);
   run_probes(rt, features(false, true), plastics, 4);
+  run_probes(rt, features(false, false, true), glass, 5); // glass: Fresnel without GGX
 }

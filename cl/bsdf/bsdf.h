@@ -1,10 +1,11 @@
 // BSDF interface: evaluation, pdf and sampling of a Material in the local shading frame
 // (z = shading normal, wo.z > 0: the caller flips the frame to face wo). Dispatches on
-// Material.type; the conductor and plastic code is compiled only when the kernel has those
-// features (cl/kernel_features.h), so a diffuse-only kernel holds no GGX or Fresnel code.
+// Material.type; the conductor, plastic and dielectric code is compiled only when the kernel has
+// those features (cl/kernel_features.h), so a diffuse-only kernel holds no GGX or Fresnel code.
 //   bsdf_eval   f(wo, wi) of the non-delta lobes (0 below the horizon: reflection only)
 //   bsdf_pdf    solid-angle pdf of bsdf_sample's non-delta directions
-//   bsdf_sample a direction from u (3 uniforms in [0, 1)): see BsdfSample (bsdf_sample.h)
+//   bsdf_sample a direction from u (3 uniforms in [0, 1)): see BsdfSample (bsdf_sample.h); a
+//               dielectric's transmitted direction has wi.z < 0
 //   bsdf_has_smooth_lobe 0 only for a pure delta BSDF (light sampling is then useless)
 // `m` points to a private copy of the material record.
 #ifndef CANOPY_CL_BSDF_BSDF_H
@@ -15,10 +16,26 @@
 #include "../types.h"
 #include "bsdf_sample.h"
 #include "conductor.h"
+#include "dielectric.h"
 #include "diffuse.h"
 #include "plastic.h"
 
+// The material as a ray arriving from inside sees it (from the side its geometric normal points
+// away from): a dielectric's relative index inverts. Called once per hit, before the BSDF.
+INLINE void material_face(Material* m, int from_inside) {
+#if HAS_MATERIAL_DIELECTRIC
+  if (from_inside && m->type == MATERIAL_DIELECTRIC && m->ior > 0.0f) m->ior = 1.0f / m->ior;
+#else
+  (void)m;
+  (void)from_inside;
+#endif
+}
+
 INLINE float3 bsdf_eval(const Material* m, float3 wo, float3 wi) {
+#if HAS_MATERIAL_DIELECTRIC
+  if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC))
+    return make_float3(0.0f, 0.0f, 0.0f);
+#endif
 #if HAS_MATERIAL_CONDUCTOR
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_eval(m, wo, wi);
 #endif
@@ -30,6 +47,9 @@ INLINE float3 bsdf_eval(const Material* m, float3 wo, float3 wi) {
 
 INLINE float bsdf_pdf(const Material* m, float3 wo, float3 wi) {
   (void)m; // diffuse_pdf needs no parameters (unused in a diffuse-only kernel)
+#if HAS_MATERIAL_DIELECTRIC
+  if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC)) return 0.0f;
+#endif
 #if HAS_MATERIAL_CONDUCTOR
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_pdf(m, wo, wi);
 #endif
@@ -40,6 +60,10 @@ INLINE float bsdf_pdf(const Material* m, float3 wo, float3 wi) {
 }
 
 INLINE BsdfSample bsdf_sample(const Material* m, float3 wo, float3 u) {
+#if HAS_MATERIAL_DIELECTRIC
+  if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC))
+    return dielectric_sample(m, wo, u);
+#endif
 #if HAS_MATERIAL_CONDUCTOR
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_sample(m, wo, u);
 #endif
@@ -50,6 +74,7 @@ INLINE BsdfSample bsdf_sample(const Material* m, float3 wo, float3 u) {
 }
 
 INLINE int bsdf_has_smooth_lobe(const Material* m) {
+  if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC)) return 0;
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR))
     return m->alpha > 0.0f; // not ggx_is_delta: compiled without HAS_MICROFACET too
   return 1;

@@ -1,13 +1,13 @@
 // Exact unpolarised Fresnel reflectance at a smooth interface, seen from outside (cos_i >= 0):
 // a dielectric of relative index eta (the plastic coat) and a conductor of complex index
-// eta + i k (per RGB channel). Compiled only for scenes with a glossy material.
+// eta + i k (per RGB channel). Compiled only for scenes with a glossy material or glass.
 #ifndef CANOPY_CL_BSDF_FRESNEL_H
 #define CANOPY_CL_BSDF_FRESNEL_H
 
 #include "../compat.h"
 #include "../kernel_features.h"
 
-#if HAS_MICROFACET
+#if HAS_FRESNEL
 
 // Dielectric: the average of the s- and p-polarised reflectances (Fresnel equations, e.g. Born &
 // Wolf §1.5.2; pbrt-v3 §8.2.1). Light arriving from the side of index 1 (eta < 1 also works:
@@ -55,5 +55,5 @@ INLINE float3 fresnel_conductor(float c, float3 eta, float3 k) {
                      fresnel_conductor1(c, eta.z, k.z));
 }
 
-#endif // HAS_MICROFACET
+#endif // HAS_FRESNEL
 #endif // CANOPY_CL_BSDF_FRESNEL_H

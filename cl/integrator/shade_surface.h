@@ -90,7 +90,9 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
       shading_normal_fix(N, wo, primitive_shading_normal(prim, sc->shading_normals, h.u, h.v, N));
   // Every ray that leaves this point (the bounce and the shadow rays of light_pick) leaves on N's
   // side, so one origin serves them all: the hit point moved off the surface by its own error
-  // bound (cl/shading.h). It is also the shading point recorded for light picking and MIS.
+  // bound (cl/shading.h). It is also the shading point recorded for light picking and MIS. (A
+  // ray refracted through glass leaves on the other side, from its own origin.)
+  float3 P_hit = P;
   P = offset_ray_origin(P, P_err, N);
   float3 beta = xyz_of(pb->throughput[path]);
 
@@ -108,6 +110,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   PathRng r;
   r.state = pb->rng[path];
   Material m = sc->materials[prim->material];
+  material_face(&m, dot(Ng, d) > 0.0f); // a ray from inside glass sees the inverse index
   if (HAS_TEXTURES ? (m.albedo_texture | m.alpha_texture) != 0 : 0) {
     // The textured albedo and alpha at the hit, kept for light_pick and brdf_mis
     // (shading_point_material).
@@ -151,13 +154,15 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   if (last && !bs.is_delta && ls->kind != SAMPLER_BSDF && !(mis_flag == 1.0f) && !env_weighs)
     return out;
   float3 wi = frame_to_world(&fr, bs.wi);
-  // A direction into the geometric surface would leak light through it (shading normals).
-  if (!(dot(wi, N) > 0.0f)) return out;
+  // A direction to the other side of the geometric surface than the lobe's would leak light
+  // through it (shading normals).
+  int through = bs.wi.z < 0.0f; // refracted (cl/bsdf/dielectric.h)
+  if (!(through ? dot(wi, N) < 0.0f : dot(wi, N) > 0.0f)) return out;
   beta = beta * bs.weight;
   if (!russian_roulette(&beta, depth, u_rr)) return out;
   if (!(max3(beta) > 0.0f) || !(bs.is_delta || bs.pdf > 0.0f)) return out;
   pb->shade_P[path] = f4_from3(P, bs.is_delta ? 0.0f : bs.pdf);
-  pb->ray_o[path] = f4_from3(P, 0.0f);
+  pb->ray_o[path] = f4_from3(through ? offset_ray_origin(P_hit, P_err, -N) : P, 0.0f);
   pb->ray_d[path] = f4_from3(normalize(wi), 0.0f);
   pb->throughput[path] = f4_from3(beta, 0.0f);
   out.x = 1;

@@ -12,7 +12,7 @@ struct KernelFeatures {
   bool light_point = false, light_spot = false, light_sphere = false, light_quad = false,
        light_triangle = false, light_disk = false, light_distant = false, light_environment = false;
   bool prim_sphere = false, prim_disk = false;
-  bool material_conductor = false, material_plastic = false;
+  bool material_conductor = false, material_plastic = false, material_dielectric = false;
   bool medium = false;          // a participating medium (cl/volume/, shade_volume)
   bool textures = false;        // a material with an image texture (cl/texture.h)
   bool volume_midpoint = false; // medium segments ranked at their midpoint (ablation)

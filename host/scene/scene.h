@@ -44,6 +44,8 @@ inline constexpr float kMinConductorEta = 0.01f;
 inline constexpr float kMaxConductorIndex = 1000.0f; // eta and k
 inline constexpr float kMaxPlasticIor = 10.0f;
 inline constexpr float kDefaultPlasticIor = 1.5f;
+// A dielectric's index, inside over outside: below 1 is a bubble (air in water, say).
+inline constexpr float kMinDielectricIor = 0.1f, kMaxDielectricIor = 10.0f;
 // Largest medium coefficient (per scene unit): sigma * distance stays finite in float over any
 // two points of the scene (2e18 * 1e20 < FLT_MAX), so transmittance underflows to 0, never NaN.
 inline constexpr float kMaxMediumCoefficient = 1e20f;
@@ -161,6 +163,16 @@ inline MaterialDesc plastic_material(std::string name, float3 albedo, float3 spe
   d.gpu.alpha = roughness * roughness;
   d.gpu.ior = ior;
   d.gpu.type = MATERIAL_PLASTIC;
+  return d;
+}
+
+// Smooth glass of index `ior` (inside over outside; cl/bsdf/dielectric.h), or a thin sheet of it.
+inline MaterialDesc dielectric_material(std::string name, float ior, bool thin) {
+  MaterialDesc d;
+  d.name = std::move(name);
+  d.gpu = Material{};
+  d.gpu.ior = ior;
+  d.gpu.type = thin ? MATERIAL_THIN_DIELECTRIC : MATERIAL_DIELECTRIC;
   return d;
 }
 

@@ -416,7 +416,7 @@ MaterialDesc parse_material(const JsonValue& v, Builder& b) {
   std::string name = nv.as_string();
   if (name.empty()) nv.fail("must not be empty");
   std::string type = "diffuse"; // the default keeps scenes written before glossy materials valid
-  if (auto t = o.get("type")) type = t->as_enum({"diffuse", "conductor", "plastic"});
+  if (auto t = o.get("type")) type = t->as_enum({"diffuse", "conductor", "plastic", "dielectric"});
   if (type == "diffuse") {
     o.allow({"name", "type", "albedo"});
     MaterialDesc d = diffuse_material(name, make_float3(0, 0, 0));
@@ -446,6 +446,14 @@ MaterialDesc parse_material(const JsonValue& v, Builder& b) {
     }
     d.gpu.alpha_texture = alpha_texture;
     return d;
+  }
+  if (type == "dielectric") {
+    o.allow({"name", "type", "ior", "thin"});
+    float ior = kDefaultPlasticIor;
+    if (auto i = o.get("ior")) ior = i->as_float_in(kMinDielectricIor, kMaxDielectricIor);
+    bool thin = false;
+    if (auto t = o.get("thin")) thin = t->as_bool();
+    return dielectric_material(name, ior, thin);
   }
   // plastic
   o.allow({"name", "type", "albedo", "specular", "roughness", "ior"});

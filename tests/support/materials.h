@@ -30,4 +30,11 @@ inline Material make_plastic(float3 albedo, float3 spec, float ior, float alpha)
   return m;
 }
 
+inline Material make_dielectric(float ior, bool thin = false) {
+  Material m{};
+  m.ior = ior;
+  m.type = thin ? MATERIAL_THIN_DIELECTRIC : MATERIAL_DIELECTRIC;
+  return m;
+}
+
 } // namespace canopy::test
