@@ -36,8 +36,8 @@ using namespace canopy;
 namespace {
 
 // A box room with every material (diffuse; rough and mirror conductors; rough and smooth-coat
-// plastics; a smooth-shaded OBJ; image textures for a diffuse albedo and a plastic's albedo and
-// roughness) lit by every light type: point, spot, sphere, quad, triangle, disk
+// plastics; glass and a thin glass sheet; a smooth-shaded OBJ; image textures for a diffuse albedo
+// and a plastic's albedo and roughness) lit by every light type: point, spot, sphere, quad, triangle, disk
 // (one-sided on the ceiling, two-sided in view of the camera), an emissive quad shape (mesh-light
 // triangles) and 300 random points, so the light tree has several levels.
 const char* kSceneJson = R"({
@@ -51,7 +51,9 @@ const char* kSceneJson = R"({
                  { "name": "coat", "type": "plastic", "albedo": [0.5, 0.5, 0.2], "roughness": 0 },
                  { "name": "painted", "albedo": { "texture": "textures/colours.png", "uv_scale": [3, 2] } },
                  { "name": "worn", "type": "plastic", "albedo": { "texture": "textures/colours.png" },
-                   "roughness": { "texture": "textures/roughness.png", "wrap": "clamp" } } ],
+                   "roughness": { "texture": "textures/roughness.png", "wrap": "clamp" } },
+                 { "name": "glass", "type": "dielectric", "ior": 1.5 },
+                 { "name": "sheet", "type": "dielectric", "ior": 1.5, "thin": true } ],
   "shapes": [
     { "type": "box", "material": "white", "min": [-3, 0, -3], "max": [3, 3, 3] },
     { "type": "box", "material": "red", "min": [-0.5, 0, -0.5], "max": [0.5, 1, 0.5], "rotate_y": 30 },
@@ -61,6 +63,9 @@ const char* kSceneJson = R"({
     { "type": "box", "material": "coat", "min": [1.0, 0, 1.5], "max": [2.5, 0.4, 2.5] },
     { "type": "box", "material": "painted", "min": [-2.9, 0, -0.5], "max": [-2.5, 2.0, 0.5] },
     { "type": "box", "material": "worn", "min": [2.5, 0, -0.5], "max": [2.9, 2.0, 1.0] },
+    { "type": "box", "material": "glass", "min": [-0.9, 0.9, 1.2], "max": [-0.2, 1.6, 1.9], "rotate_y": 20 },
+    { "type": "quad", "material": "sheet", "corner": [0.3, 0.8, 1.5], "edge1": [0.8, 0, 0],
+      "edge2": [0, 0.8, 0.2] },
     { "type": "obj", "file": "smooth.obj", "material": "gold",
       "transform": { "scale": 1.5, "translate": [0.5, 1.2, 0.5] } },
     { "type": "quad", "corner": [-1, 2.9, -1], "edge1": [2, 0, 0], "edge2": [0, 0, 0.2],
