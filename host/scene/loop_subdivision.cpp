@@ -23,16 +23,16 @@ double3 cross(double3 a, double3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 
-// Warren's weight of each neighbour of an interior even vertex of valence n (Warren 1995,
-// "Subdivision methods for geometric design"), as pbrt-v4 uses it: 3/16 for n = 3, else 3/(8n).
+// The weight of each neighbour of an interior even vertex of valence n: Warren's simplification
+// of Loop's weight, as pbrt-v4 uses it (PBR 3rd ed., section 3.8): 3/16 for n = 3, else 3/(8n).
 double warren_beta(size_t n) {
   return n == 3 ? 3.0 / 16.0 : 3.0 / (8.0 * double(n));
 }
 
 // The weight of each neighbour in an interior vertex's limit position: the left eigenvector of
-// eigenvalue 1 of the subdivision matrix on the vertex and its ring, (1 - n gamma, gamma, ...),
-// with gamma = 1 / (n + 3 / (8 beta)) (Halstead, Kass and DeRose 1993, "Efficient, fair
-// interpolation using Catmull-Clark surfaces", appendix A; PBR 3rd ed., section 3.8).
+// eigenvalue 1 of the subdivision matrix on the vertex and its ring, (1 - n gamma, gamma, ...):
+// l S = l holds in a neighbour's entry when gamma (3/8 + 1/8 + 1/8) + (1 - n gamma) beta =
+// gamma, i.e. gamma = 1 / (n + 3 / (8 beta)) (PBR 3rd ed., section 3.8).
 double limit_gamma(size_t n) {
   return 1.0 / (double(n) + 3.0 / (8.0 * warren_beta(n)));
 }
@@ -132,7 +132,8 @@ double3 limit_normal(const std::vector<double3>& p, uint32_t v, const MeshTopolo
 // Interior: the left eigenvector of eigenvalue 1 (limit_gamma). Boundary: the cubic B-spline's
 // limit (1/6, 2/3, 1/6) of the vertex and its boundary neighbours, the left eigenvector of the
 // boundary rules. pbrt-v4 uses (1/5, 3/5, 1/5), which is not: a boundary vertex's point would
-// then move with the level (a corner of a flat square by 1/40 of an edge from level 0 to 1).
+// then move with the level (a corner of a flat square by (e1 + e2)/40, for unit steps e1, e2
+// along its sides, from level 0 to 1).
 double3 limit_position(const std::vector<double3>& p, uint32_t v, const MeshTopology& topo) {
   size_t n = topo.valence(v);
   const uint32_t* r = topo.ring_of(v);

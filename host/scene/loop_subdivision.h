@@ -21,6 +21,9 @@ struct SubdividedMesh {
   std::vector<float3> positions; // on the limit surface
   // Per vertex: the limit surface's unit normal, on the side the triangles' winding gives
   // ((p1 - p0) x (p2 - p0)); zero where the surface has no tangent plane (a degenerate ring).
+  // pbrt-v4's normals are the opposite ones, and pbrt turns a triangle's geometric normal to its
+  // shading normal, so a pbrt loopsubdiv surface faces against its winding: what one-sided
+  // emission and a dielectric's inside see (the killeroo is wound outward, so in pbrt it faces in).
   std::vector<float3> normals;
   std::vector<uint32_t> indices; // 3 per triangle, wound as the input
 };

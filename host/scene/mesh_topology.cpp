@@ -48,24 +48,30 @@ std::pair<const uint32_t*, const uint32_t*> half_edges_between(const OutgoingHal
           std::upper_bound(first, last, to, less_dest)};
 }
 
+// Per vertex a, its outgoing half-edges come in runs of equal destination b: a run of two is two
+// triangles running the same way from a to b; the half-edges from b to a are found by a binary
+// search in b's.
 std::vector<uint32_t> find_twins(const std::vector<uint32_t>& idx, const OutgoingHalfEdges& out) {
   std::vector<uint32_t> twin(idx.size(), kNoHalfEdge);
-  for (uint32_t h = 0; h < idx.size(); ++h) {
-    uint32_t a = idx[h], b = idx[next_half_edge(h)];
-    auto same = half_edges_between(out, idx, a, b);
-    auto opposite = half_edges_between(out, idx, b, a);
-    size_t n_same = size_t(same.second - same.first);
-    size_t n_opposite = size_t(opposite.second - opposite.first);
-    if (n_same + n_opposite > 2)
-      throw SceneError(fmt::format("the edge between vertices {} and {} is shared by {} triangles "
-                                   "(the surface must be a manifold)",
-                                   std::min(a, b), std::max(a, b), n_same + n_opposite));
-    if (n_same == 2)
-      throw SceneError(fmt::format("the two triangles on the edge between vertices {} and {} are "
-                                   "wound in opposite directions (inconsistent orientation)",
-                                   std::min(a, b), std::max(a, b)));
-    if (n_opposite == 1) twin[h] = *opposite.first;
-  }
+  const uint32_t vertex_count = uint32_t(out.start.size() - 1);
+  for (uint32_t a = 0; a < vertex_count; ++a)
+    for (uint32_t i = out.start[a], run; i < out.start[a + 1]; i += run) {
+      uint32_t b = idx[next_half_edge(out.half_edges[i])];
+      run = 1;
+      while (i + run < out.start[a + 1] && idx[next_half_edge(out.half_edges[i + run])] == b)
+        ++run;
+      auto opposite = half_edges_between(out, idx, b, a);
+      size_t n_opposite = size_t(opposite.second - opposite.first);
+      if (run + n_opposite > 2)
+        throw SceneError(fmt::format("the edge between vertices {} and {} is shared by {} "
+                                     "triangles (the surface must be a manifold)",
+                                     std::min(a, b), std::max(a, b), run + n_opposite));
+      if (run == 2)
+        throw SceneError(fmt::format("the two triangles on the edge between vertices {} and {} "
+                                     "are wound in opposite directions (inconsistent orientation)",
+                                     std::min(a, b), std::max(a, b)));
+      if (n_opposite == 1) twin[out.half_edges[i]] = *opposite.first;
+    }
   return twin;
 }
 
