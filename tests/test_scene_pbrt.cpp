@@ -1,4 +1,4 @@
-// The pbrt-v4 reader (host/scene/pbrt_reader.cpp): properties of the Scene it builds, checked
+// The pbrt-v4 reader (host/scene/pbrt/): properties of the Scene it builds, checked
 // against values worked out by hand from pbrt-v4's conventions, and its errors and warnings.
 #include "scene/pbrt_reader.h"
 #include "scene/scene.h"

@@ -19,7 +19,7 @@ struct PlyMesh {
   std::vector<uint32_t> indices; // 3 per triangle, into positions
   std::vector<float3> normals;   // per vertex (nx ny nz), as stored; empty if the file has none
   // Per vertex (u v, s t, texture_u texture_v or texture_s texture_t), as stored; empty if the
-  // file has none. The plymesh's uv (pbrt_reader.cpp).
+  // file has none. The plymesh's uv (pbrt/shapes.cpp).
   std::vector<float2> uv;
   size_t skipped_faces = 0; // faces of fewer than 3 vertices (points, lines)
 };

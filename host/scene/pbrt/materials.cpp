@@ -1,0 +1,201 @@
+// The materials of a pbrt-v4 file: Material and MakeNamedMaterial.
+#include "scene/metal_presets.h"
+#include "scene/pbrt/reader.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace canopy::pbrt {
+
+// The format page, "Materials". Returns the index of the new scene material.
+int Reader::material(const Loc& loc, Params& p, const std::string& type, const std::string& name) {
+  // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha is alpha = sqrt(roughness), applied
+  // when remaproughness is true (the default); Canopy's roughness r means alpha = r^2
+  // (scene.h conductor_material). So Canopy's r is roughness^(1/4) when remapped and
+  // sqrt(roughness) otherwise. Alpha above 1 is beyond Canopy's range and is clamped.
+  // A roughness image texture sets *alpha_texture instead (map TEXTURE_MAP_ALPHA_SQRT, or
+  // TEXTURE_MAP_VALUE without remapping); the returned constant is then unused.
+  using K = NamedTexture::Kind;
+  int albedo_texture = 0, alpha_texture = 0;
+  auto roughness = [&]() -> float {
+    // pbrt-v4: uroughness and vroughness, each defaulting to roughness (itself 0).
+    struct Rough {
+      double value = 0.0;
+      const NamedTexture* image = nullptr; // in float_textures_ (stable)
+      const Param* param = nullptr;
+    };
+    auto get = [&](const char* key) -> std::optional<Rough> {
+      Param* q = p.find(key);
+      if (!q) return std::nullopt;
+      if (q->type != "texture") return Rough{p.get_float(key, 0.0), nullptr, q};
+      std::optional<NamedTexture> t = texture_param(p, key, true);
+      if (t->kind == K::Image) return Rough{0.0, &float_textures_.at(q->strs[0]), q};
+      return Rough{t->kind == K::Constant ? double(t->value.x) : 0.0, nullptr, q};
+    };
+    Rough r = get("roughness").value_or(Rough{});
+    Rough u = get("uroughness").value_or(r), v = get("vroughness").value_or(r);
+    bool remap = p.get_bool("remaproughness", true);
+    if (u.image || v.image) {
+      const Rough& used = u.image ? u : v;
+      if (u.image != v.image || u.value != v.value)
+        warn(used.param->loc,
+             fmt::format("{}: uroughness and vroughness differ: Canopy's GGX is isotropic, the "
+                         "texture \"{}\" used, anisotropy ignored",
+                         p.what(), printable(used.image->name)));
+      alpha_texture =
+          texture_index(*used.image, 1, remap ? TEXTURE_MAP_ALPHA_SQRT : TEXTURE_MAP_VALUE);
+      return 0.0f;
+    }
+    if (u.value != v.value)
+      warn(u.param ? u.param->loc : v.param->loc,
+           fmt::format("{}: uroughness {} != vroughness {}: Canopy's GGX is isotropic, their mean "
+                       "used, anisotropy ignored",
+                       p.what(), u.value, v.value));
+    double rr = 0.5 * (u.value + v.value);
+    if (!(rr >= 0.0)) fail(loc, fmt::format("{}: roughness must be >= 0", p.what()));
+    double alpha = remap ? std::sqrt(rr) : rr;
+    if (alpha > 1.0) {
+      warn(loc,
+           fmt::format("{}: GGX alpha {} > 1 clamped to 1, the excess ignored", p.what(), alpha));
+      alpha = 1.0;
+    }
+    return float(std::sqrt(alpha));
+  };
+  auto clamp01 = [](float3 c) {
+    // pbrt-v4 clamps reflectances to [0, 1] (DiffuseMaterial, CoatedDiffuseMaterial).
+    return make_float3(std::min(c.x, 1.0f), std::min(c.y, 1.0f), std::min(c.z, 1.0f));
+  };
+  auto albedo = [&](const char* key) {
+    const float3 def = make_float3(0.5f, 0.5f, 0.5f);
+    if (Param* q = p.find(key); q && q->type == "texture") {
+      std::optional<NamedTexture> t = texture_param(p, key, false);
+      if (t->kind == K::Image)
+        albedo_texture = texture_index(spectrum_textures_.at(q->strs[0]), 3, TEXTURE_MAP_VALUE);
+      return t->kind == K::Constant ? clamp01(t->value) : def;
+    }
+    return clamp01(p.spectrum(key, Params::Use::Reflectance).value_or(def));
+  };
+  std::string mname = name.empty() ? fmt::format("pbrt:{}:{}", *loc.file, loc.line) : name;
+  for (const char* skip : {"displacement", "normalmap"})
+    if (Param* q = p.find(skip))
+      warn(q->loc, fmt::format("{}: \"{} {}\" ignored", p.what(), q->type, skip));
+  MaterialDesc md;
+  if (type == "diffuse") {
+    md = diffuse_material(mname, albedo("reflectance"));
+  } else if (type == "conductor") {
+    float r = roughness();
+    float3 eta, k;
+    // A textured "reflectance": only a constant texture is read (an image warns, and the
+    // default conductor, eta and k, is used).
+    std::optional<float3> refl;
+    if (Param* q = p.find("reflectance"); q && q->type == "texture") {
+      std::optional<NamedTexture> t = texture_param(p, "reflectance", false);
+      if (t->kind == K::Constant)
+        refl = clamp01(t->value);
+      else if (t->kind == K::Image)
+        warn(q->loc, fmt::format("{}: \"texture reflectance\" \"{}\": Canopy's conductor takes no "
+                                 "reflectance image (eta and k used), ignored",
+                                 p.what(), printable(q->strs[0])));
+    } else if (q) {
+      refl = albedo("reflectance");
+    }
+    if (refl) {
+      // pbrt-v4 ConductorMaterial with "reflectance": eta = 1, k = 2 sqrt(r) / sqrt(1 - r),
+      // the index whose normal-incidence Fresnel reflectance is r.
+      float3 c = *refl;
+      auto kk = [](float x) {
+        x = std::clamp(x, 0.0f, 0.9999f);
+        return 2.0f * std::sqrt(x) / std::sqrt(1.0f - x);
+      };
+      eta = make_float3(1, 1, 1);
+      k = make_float3(kk(c.x), kk(c.y), kk(c.z));
+    } else {
+      // Named spectra "metal-<X>-eta"/"metal-<X>-k" (pbrt-v4 spectrum.cpp) map to Canopy's
+      // measured presets (metal_presets.cpp); copper is pbrt's default conductor.
+      auto preset_of = [&](const std::string& spec, const char* which) -> const MetalPreset* {
+        static const std::map<std::string, std::string> m = {
+            {"Au", "gold"}, {"Ag", "silver"}, {"Cu", "copper"}, {"Al", "aluminium"}};
+        std::string pre = "metal-", suf = std::string("-") + which;
+        if (spec.size() > pre.size() + suf.size() && spec.rfind(pre, 0) == 0 &&
+            spec.compare(spec.size() - suf.size(), suf.size(), suf) == 0) {
+          auto it = m.find(spec.substr(pre.size(), spec.size() - pre.size() - suf.size()));
+          if (it != m.end()) return find_metal_preset(it->second);
+        }
+        warn(p.find(which)->loc,
+             fmt::format("{}: spectrum \"{}\" has no Canopy preset (gold, silver, copper, "
+                         "aluminium): copper used, the spectrum ignored",
+                         p.what(), printable(spec)));
+        return find_metal_preset("copper");
+      };
+      const MetalPreset* cu = find_metal_preset("copper");
+      eta = make_float3(cu->eta[0], cu->eta[1], cu->eta[2]);
+      k = make_float3(cu->k[0], cu->k[1], cu->k[2]);
+      std::string named;
+      if (auto e = p.spectrum("eta", Params::Use::Reflectance, &named)) {
+        eta = *e;
+      } else if (!named.empty()) {
+        const MetalPreset* pr = preset_of(named, "eta");
+        eta = make_float3(pr->eta[0], pr->eta[1], pr->eta[2]);
+      }
+      named.clear();
+      if (auto e = p.spectrum("k", Params::Use::Reflectance, &named)) {
+        k = *e;
+      } else if (!named.empty()) {
+        const MetalPreset* pr = preset_of(named, "k");
+        k = make_float3(pr->k[0], pr->k[1], pr->k[2]);
+      }
+      auto in = [](float3 c, float lo, float hi) {
+        return c.x >= lo && c.y >= lo && c.z >= lo && c.x <= hi && c.y <= hi && c.z <= hi;
+      };
+      if (!in(eta, kMinConductorEta, kMaxConductorIndex))
+        fail(loc, fmt::format("{}: eta must be in [{}, {}]", p.what(), kMinConductorEta,
+                              kMaxConductorIndex));
+      if (!in(k, 0.0f, kMaxConductorIndex))
+        fail(loc, fmt::format("{}: k must be in [0, {}]", p.what(), kMaxConductorIndex));
+    }
+    md = conductor_material(mname, r, eta, k);
+  } else if (type == "coateddiffuse") {
+    // pbrt-v4 CoatedDiffuse is a dielectric coat (index eta) over a Lambertian base, with light
+    // bouncing between the two simulated stochastically. Canopy's plastic is the same pair of
+    // lobes added without that coupling: the specular GGX lobe with the coat's Fresnel
+    // reflectance and roughness matches; the diffuse part is lighter and less saturated than
+    // pbrt's (which loses energy to the coat's internal reflection and tints it by repeated
+    // bounces). The coat medium (albedo, thickness, g) is not modelled.
+    float3 kd = albedo("reflectance");
+    float r = roughness();
+    double eta = kDefaultPlasticIor;
+    if (Param* q = p.find("eta")) {
+      if (q->type == "float") {
+        eta = p.get_float("eta", kDefaultPlasticIor);
+        if (!(eta >= 1.0 && eta <= kMaxPlasticIor))
+          fail(q->loc,
+               fmt::format("{}: \"float eta\": must be in [1, {}]", p.what(), kMaxPlasticIor));
+      } else {
+        warn(q->loc,
+             fmt::format("{}: a spectral \"eta\" ({} used) ignored", p.what(), kDefaultPlasticIor));
+      }
+    }
+    if (Param* q = p.find("albedo"))
+      warn(q->loc, fmt::format("{}: \"albedo\" of the coat medium ignored", p.what()));
+    for (const char* skip : {"thickness", "g", "maxdepth", "nsamples"})
+      if (Param* q = p.find(skip))
+        warn(q->loc, fmt::format("{}: \"{}\" (the coat's random walk) ignored", p.what(), skip));
+    md = plastic_material(mname, kd, make_float3(1, 1, 1), r, float(eta));
+  } else {
+    warn(loc, fmt::format("Material \"{}\" is not read in this slice (diffuse 0.5 used), ignored",
+                          printable(type)));
+    scene_.materials.push_back(diffuse_material(mname, make_float3(0.5f, 0.5f, 0.5f)));
+    return int(scene_.materials.size()) - 1;
+  }
+  p.find("type"); // MakeNamedMaterial's type is read by the caller
+  p.finish();
+  md.gpu.albedo_texture = albedo_texture;
+  md.gpu.alpha_texture = alpha_texture;
+  scene_.materials.push_back(md);
+  return int(scene_.materials.size()) - 1;
+}
+
+} // namespace canopy::pbrt
