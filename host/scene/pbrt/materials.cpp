@@ -10,6 +10,39 @@
 
 namespace canopy::pbrt {
 
+// A dielectric's "eta": a float, or one of pbrt-v4's named glass spectra as its index at 550 nm
+// (pbrt-v4 spectrum.cpp's tables; Canopy renders in RGB, so without dispersion: warned).
+// Default 1.5, as pbrt-v4's.
+float Reader::dielectric_eta(Params& p) {
+  Param* q = p.find("eta");
+  if (!q) return 1.5f;
+  if (q->type == "float") {
+    double eta = p.get_float("eta", 1.5);
+    if (!(eta >= kMinDielectricIor && eta <= kMaxDielectricIor))
+      fail(q->loc, fmt::format("{}: \"float eta\": must be in [{}, {}]", p.what(),
+                               kMinDielectricIor, kMaxDielectricIor));
+    return float(eta);
+  }
+  static const std::map<std::string, float> glass = {
+      {"glass-BK7", 1.51854f},   {"glass-BAF10", 1.67305f}, {"glass-FK51A", 1.48780f},
+      {"glass-LASF9", 1.85581f}, {"glass-F5", 1.67709f},    {"glass-F10", 1.73357f},
+      {"glass-F11", 1.79112f}};
+  std::string named;
+  if (q->type == "spectrum" && !q->strs.empty()) {
+    named = q->strs[0];
+    auto it = glass.find(named);
+    if (it != glass.end()) {
+      warn(q->loc, fmt::format("{}: \"spectrum eta\" \"{}\": its index at 550 nm, {}, used "
+                               "(no dispersion)",
+                               p.what(), named, it->second));
+      return it->second;
+    }
+  }
+  warn(q->loc, fmt::format("{}: \"{} eta\"{}: not a float or a named glass, 1.5 used", p.what(),
+                           q->type, named.empty() ? "" : " \"" + printable(named) + "\""));
+  return 1.5f;
+}
+
 // The format page, "Materials". Returns the index of the new scene material.
 int Reader::material(const Loc& loc, Params& p, const std::string& type, const std::string& name) {
   // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha is alpha = sqrt(roughness), applied
@@ -184,6 +217,18 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
       if (Param* q = p.find(skip))
         warn(q->loc, fmt::format("{}: \"{}\" (the coat's random walk) ignored", p.what(), skip));
     md = plastic_material(mname, kd, make_float3(1, 1, 1), r, float(eta));
+  } else if (type == "dielectric" || type == "thindielectric") {
+    const bool thin = type == "thindielectric";
+    float ior = dielectric_eta(p);
+    if (!thin) {
+      float r = roughness();
+      if (r > 0.0f || alpha_texture)
+        warn(loc, fmt::format("{}: a rough dielectric is rendered smooth (Canopy's glass is "
+                              "smooth), the roughness ignored",
+                              p.what()));
+      alpha_texture = 0;
+    }
+    md = dielectric_material(mname, ior, thin);
   } else {
     warn(loc, fmt::format("Material \"{}\" is not read in this slice (diffuse 0.5 used), ignored",
                           printable(type)));

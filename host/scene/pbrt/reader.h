@@ -113,6 +113,7 @@ private:
   void infinite_light(const Token& d, Params& p, const std::filesystem::path& dir);
   void area_light(const Token& d, Params& p, const std::string& type);
   int material(const Loc& loc, Params& p, const std::string& type, const std::string& name);
+  float dielectric_eta(Params& p);
   void texture(const Token& d, Params& p, const std::string& name, const std::string& type,
                const std::string& cls, const std::filesystem::path& dir);
   NamedTexture image_texture(const Loc& loc, Params& p, const std::string& name,

@@ -1,4 +1,5 @@
 // The Shape directive of a pbrt-v4 file, and the meshes it adds to the scene.
+#include "scene/loop_subdivision.h"
 #include "scene/pbrt/meshes.h"
 #include "scene/pbrt/reader.h"
 #include "scene/pbrt/transforms.h"
@@ -207,6 +208,28 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
       }
       if (gs_.reverse) reverse_winding(m); // spheres keep their outward shading normals
     }
+  } else if (type == "loopsubdiv") {
+    // Tessellated here, as pbrt-v4 does at load time (scene/loop_subdivision.h).
+    std::vector<float3> P = points("P", 3);
+    std::vector<uint32_t> idx = indices(3, P.size());
+    int levels = 3; // pbrt-v4's default
+    if (Param* q = p.one("levels", {"integer"})) {
+      if (!(q->nums[0] >= 0 && q->nums[0] <= 16))
+        fail(q->loc, fmt::format("{}: \"integer levels\": must be in [0, 16]", p.what()));
+      levels = int(q->nums[0]);
+    }
+    detail::SubdividedMesh sd;
+    try {
+      sd = detail::loop_subdivide(P, idx, levels);
+    } catch (const SceneError& e) {
+      fail(loc, fmt::format("{}: {}", p.what(), e.what()));
+    }
+    // pbrt-v4's limit normals point against the winding, and its triangles face their shading
+    // normals: the surface faces against its winding (add_polygons turns the winding to them).
+    m.vertices = std::move(sd.positions);
+    for (const float3& n : sd.normals)
+      m.normals.push_back(n * -1.0f);
+    add_polygons(m, sd.indices, false, gs_.material, emission(), gs_.reverse);
   } else {
     warn(loc, fmt::format("Shape \"{}\" is not read in this slice, ignored", printable(type)));
     return;
