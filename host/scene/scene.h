@@ -160,6 +160,8 @@ inline MaterialDesc plastic_material(std::string name, float3 albedo, float3 spe
 struct EnvironmentMap {
   std::filesystem::path file;
   int projection = 0;
+  // Names it in messages: "<scene file>: <light's JSON path>" or "<file>:<line>: LightSource ...".
+  std::string where;
 };
 
 // How an image's stored values become linear ones (pbrt-v4's "encoding" of image textures).
