@@ -229,6 +229,18 @@ canopy_cli_test(cli_pbrt_render_textured
 canopy_cli_test(cli_pbrt_texture_missing -DSCENE=${CANOPY_PBRT_DATA}/texture_missing.pbrt
   "-DEXPECT=${CANOPY_PBRT_DATA}/texture_missing.pbrt:4: Texture \"wood\": \"string filename\" ${CANOPY_PBRT_DATA}/textures/no_such.png: no such file"
   -P ${CANOPY_CHECK2})
+# A corrupt image is one line too: libpng's own "libpng error: ..." line (printed on stderr by the
+# library itself) must not precede Canopy's message (PREFIX: the message alone on stderr). A PNG
+# texture cut in half names the Texture's file:line and the image; an environment map whose IHDR
+# is invalid names the LightSource's file:line and the image.
+canopy_cli_test(cli_pbrt_texture_truncated_png -DSCENE=${CANOPY_PBRT_DATA}/texture_truncated.pbrt
+  -DPREFIX=ON
+  "-DEXPECT=${CANOPY_PBRT_DATA}/texture_truncated.pbrt:6: texture \"wood\": ${CANOPY_PBRT_DATA}/textures/truncated.png: cannot read the texture"
+  -P ${CANOPY_CHECK2})
+canopy_cli_test(cli_pbrt_envmap_bad_ihdr_png -DSCENE=${CANOPY_PBRT_DATA}/envmap_bad_ihdr.pbrt
+  -DPREFIX=ON
+  "-DEXPECT=${CANOPY_PBRT_DATA}/envmap_bad_ihdr.pbrt:6: LightSource \"infinite\": ${CANOPY_PBRT_DATA}/textures/bad_ihdr.png: cannot read the environment map"
+  -P ${CANOPY_CHECK2})
 # An Include cycle: exit 2, the cycle named.
 canopy_cli_test(cli_pbrt_include_cycle -DSCENE=${CANOPY_PBRT_DATA}/cycle_a.pbrt
   "-DEXPECT=${CANOPY_PBRT_DATA}/cycle_b.pbrt:2: Include cycle: ${CANOPY_PBRT_DATA}/cycle_a.pbrt -> ${CANOPY_PBRT_DATA}/cycle_b.pbrt -> ${CANOPY_PBRT_DATA}/cycle_a.pbrt"

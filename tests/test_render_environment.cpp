@@ -178,18 +178,17 @@ TEST(EnvironmentSampling, TexelsFollowThePmfAndPdfsAgree) {
 }
 
 TEST(EnvironmentSampling, BadMapsAreOneLineErrors) {
-  std::vector<EnvironmentMap> maps = {
-      {write_map("wide.exr", 4, 2, std::vector<float>(24, 1.0f)), ENV_OCTAHEDRAL}};
+  const auto wide = write_map("wide.exr", 4, 2, std::vector<float>(24, 1.0f));
+  std::vector<EnvironmentMap> maps = {{wide, ENV_OCTAHEDRAL, "sky.pbrt:3: LightSource"}};
   std::vector<Light> lights = {env_light(make_float3(1, 1, 1), 0)};
   try {
     build_environment_data(lights, maps);
     ADD_FAILURE() << "a 4x2 octahedral map was accepted";
   } catch (const SceneError& err) {
-    EXPECT_NE(std::string(err.what())
-                  .find("wide.exr: the equal-area octahedral projection needs "
-                        "a square map, not 4x2"),
-              std::string::npos)
-        << err.what();
+    // where the map is named (EnvironmentMap::where), then the file
+    EXPECT_EQ(std::string(err.what()), "sky.pbrt:3: LightSource: " + wide.string() +
+                                           ": the equal-area octahedral projection needs "
+                                           "a square map, not 4x2");
   }
   std::vector<float> neg(12, 1.0f);
   neg[4] = -1.0f;
@@ -330,6 +329,7 @@ TEST(EnvironmentScene, JsonAndPbrt) {
   ASSERT_EQ(s.environment_maps.size(), 1u);
   EXPECT_EQ(m.pad, 0);
   EXPECT_EQ(s.environment_maps[0].projection, ENV_EQUIRECT);
+  EXPECT_EQ(s.environment_maps[0].where, "sky.json: lights[1]");
   EXPECT_FLOAT_EQ(m.n.z, 1.0f);   // the pole: up
   EXPECT_FLOAT_EQ(m.e1.x, -1.0f); // the image centre (phi = pi, -e1) looks along front
   EXPECT_FLOAT_EQ(m.emission.x, 2.0f);
@@ -359,6 +359,7 @@ TEST(EnvironmentScene, JsonAndPbrt) {
   EXPECT_FLOAT_EQ(p.infinite_lights[0].emission.y, 2.0f);
   ASSERT_EQ(p.environment_maps.size(), 1u);
   EXPECT_EQ(p.environment_maps[0].projection, ENV_OCTAHEDRAL);
+  EXPECT_EQ(p.environment_maps[0].where, "sky.pbrt:7: LightSource \"infinite\"");
   // Rotate 90 about x takes the map's z (its pole) to -y... up to the reader's handedness mirror,
   // which leaves y alone.
   EXPECT_NEAR(std::fabs(p.infinite_lights[1].n.y), 1.0f, 1e-6f);

@@ -339,6 +339,18 @@ TEST(TextureImages, BadImagesAreErrorsNamingTheFile) {
   img.rgb[4] = -1.0f;
   write_exr(dir / "neg.exr", img);
   expect_error(texture_desc(dir / "neg.exr", 1, 0), "texel (1, 0) is -1");
+  // A PNG cut short: libpng's own "libpng error: ..." line is not printed (it becomes the reason
+  // at the end of the one-line error).
+  RgbImage grey;
+  grey.width = grey.height = 8;
+  grey.rgb.assign(8 * 8 * 3, 0.5f);
+  write_png(dir / "whole.png", grey);
+  std::ifstream whole(dir / "whole.png", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
+  std::ofstream(dir / "cut.png", std::ios::binary) << bytes.substr(0, 40);
+  testing::internal::CaptureStderr();
+  expect_error(texture_desc(dir / "cut.png", 3, 0), "cannot read the texture (");
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 }
 
 // Kernels hold texture code only for scenes with a textured material.

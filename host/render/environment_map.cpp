@@ -45,7 +45,10 @@ EnvironmentData build_environment_data(std::vector<Light>& infinite,
       continue;
     }
     const EnvironmentMap& map = maps.at(size_t(l.pad));
-    RenderImage img = read_render_image(map.file, "environment map", kMaxEnvironmentTexels, 3);
+    const std::string who =
+        map.where.empty() ? map.file.string() : fmt::format("{}: {}", map.where, map.file.string());
+    RenderImage img = read_render_image(map.file, "environment map", kMaxEnvironmentTexels, 3,
+                                        ImageEncoding::Auto, 1.0f, map.where);
     const int w = img.width, h = img.height;
     std::vector<float4> texels(size_t(w) * size_t(h));
     for (size_t p = 0; p < texels.size(); ++p)
@@ -54,10 +57,10 @@ EnvironmentData build_environment_data(std::vector<Light>& infinite,
     if (map.projection == ENV_OCTAHEDRAL && w != h)
       throw SceneError(fmt::format("{}: the equal-area octahedral projection needs a square map, "
                                    "not {}x{}",
-                                   map.file.string(), w, h));
+                                   who, w, h));
     if (d.texels.size() + texels.size() > kMaxEnvironmentTexels)
       throw SceneError(fmt::format("{}: the environment maps have more than {} texels together",
-                                   map.file.string(), kMaxEnvironmentTexels));
+                                   who, kMaxEnvironmentTexels));
     AliasTable table(environment_texel_weights(texels, w, h, map.projection));
     const uint32_t first = uint32_t(d.texels.size());
     l.p = make_float4(uint_as_float_(first), uint_as_float_(uint32_t(w)),

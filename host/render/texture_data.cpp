@@ -1,23 +1,42 @@
 #include "render/texture_data.h"
 
 #include "image/image_io.h"
+#include "image/stderr_capture.h"
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <cmath>
 #include <map>
+#include <string>
 #include <tuple>
 
 namespace canopy {
+
+namespace {
+
+// Why an image could not be read, for the end of Canopy's one-line message: what the image
+// library printed (captured, stderr_capture.h), else the first line of OpenImageIO's error;
+// empty if neither says anything.
+std::string read_failure(const std::string& printed, const std::string& oiio_error) {
+  if (!printed.empty()) return printed;
+  return oiio_error.substr(0, oiio_error.find('\n'));
+}
+
+} // namespace
 
 RenderImage read_render_image(const std::filesystem::path& file, const std::string& what,
                               size_t max_texels, int channels, ImageEncoding encoding, float gamma,
                               const std::string& where) {
   const std::string name = file.string();
   const std::string who = where.empty() ? name : fmt::format("{}: {}", where, name);
+  StderrCapture library_output; // a corrupt PNG makes libpng print its own line
   auto in = OIIO::ImageInput::open(name);
-  if (!in) throw SceneError(fmt::format("{}: cannot read the {}", who, what));
+  if (!in) {
+    std::string why = read_failure(library_output.finish(), OIIO::geterror());
+    throw SceneError(fmt::format("{}: cannot read the {}{}", who, what,
+                                 why.empty() ? "" : fmt::format(" ({})", why)));
+  }
   const OIIO::ImageSpec spec = in->spec();
   const int nc = spec.nchannels;
   if (spec.width < 1 || spec.height < 1 || nc < 1)
@@ -26,8 +45,12 @@ RenderImage read_render_image(const std::filesystem::path& file, const std::stri
     throw SceneError(fmt::format("{}: {}x{} texels is more than a {} may have ({})", who,
                                  spec.width, spec.height, what, max_texels));
   std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(nc));
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
-    throw SceneError(fmt::format("{}: cannot read the {} (truncated or corrupt)", who, what));
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data())) {
+    std::string why = read_failure(library_output.finish(), in->geterror());
+    throw SceneError(fmt::format("{}: cannot read the {} (truncated or corrupt{})", who, what,
+                                 why.empty() ? "" : ": " + why));
+  }
+  library_output.finish();
   const bool integer = spec.format.basetype != OIIO::TypeDesc::FLOAT &&
                        spec.format.basetype != OIIO::TypeDesc::HALF &&
                        spec.format.basetype != OIIO::TypeDesc::DOUBLE;

@@ -19,8 +19,9 @@ struct RenderImage {
 
 // Reads `file` as `channels` (3: rgb, a grey image's one channel thrice; 1: the mean of its colour
 // channels) linear values. `what` names it in messages ("environment map", "texture"), after
-// `where` when given. Throws SceneError naming the file when it cannot be read, has no pixels, more
-// than `max_texels` texels, or a value that is not finite and >= 0 (after decoding).
+// `where` when given. Throws SceneError naming the file when it cannot be read (with the image
+// library's reason; what the library prints on stderr meanwhile is captured, not shown), has no
+// pixels, more than `max_texels` texels, or a value that is not finite and >= 0 (after decoding).
 RenderImage read_render_image(const std::filesystem::path& file, const std::string& what,
                               size_t max_texels, int channels,
                               ImageEncoding encoding = ImageEncoding::Auto, float gamma = 1.0f,

@@ -198,6 +198,7 @@ Light parse_environment_light(const JsonValue& v, Builder& b) {
   EnvironmentMap map;
   map.file = p;
   map.projection = ENV_EQUIRECT;
+  map.where = fmt::format("{}: {}", b.file, v.path());
   if (auto pv = o.get("projection"))
     map.projection =
         pv->as_enum({"equirect", "octahedral"}) == "equirect" ? ENV_EQUIRECT : ENV_OCTAHEDRAL;

@@ -181,6 +181,8 @@ inline MaterialDesc dielectric_material(std::string name, float ior, bool thin) 
 struct EnvironmentMap {
   std::filesystem::path file;
   int projection = 0;
+  // Names it in messages: "<scene file>: <light's JSON path>" or "<file>:<line>: LightSource ...".
+  std::string where;
 };
 
 // How an image's stored values become linear ones (pbrt-v4's "encoding" of image textures).

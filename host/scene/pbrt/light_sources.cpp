@@ -127,7 +127,8 @@ void Reader::infinite_light(const Token& d, Params& p, const std::filesystem::pa
     if (!std::filesystem::is_regular_file(file, ec))
       fail(d.loc, fmt::format("{}: \"filename\" {}: no such file", p.what(), file.string()));
     l.pad = int(scene_.environment_maps.size());
-    scene_.environment_maps.push_back({file, ENV_OCTAHEDRAL});
+    scene_.environment_maps.push_back(
+        {file, ENV_OCTAHEDRAL, fmt::format("{}:{}: {}", *d.loc.file, d.loc.line, p.what())});
     l.emission = f4_from3(to_float3(double3{scale, scale, scale}), 0.0f);
   } else {
     float3 L = p.spectrum("L", Params::Use::Illuminant).value_or(make_float3(1, 1, 1));
