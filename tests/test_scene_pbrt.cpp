@@ -356,7 +356,7 @@ TEST(ScenePbrt, ConductorRoughnessAndMetalPresets) {
 TEST(ScenePbrt, UnknownMaterialAndTextureFallBackWithWarnings) {
   Scene s = load(
       std::string(kKeptCamera) + "WorldBegin\n" + "Texture \"t\" \"spectrum\" \"checkerboard\"\n" +
-      "Material \"dielectric\" \"float eta\" 1.5\n" + tri_at("0 0 0  1 0 0  0 1 0") +
+      "Material \"hair\" \"float eta\" 1.5\n" + tri_at("0 0 0  1 0 0  0 1 0") +
       "Material \"diffuse\" \"texture reflectance\" \"t\"\n" + tri_at("0 0 0  1 0 0  0 1 0"));
   // The unsupported texture class warns where it is defined, not again where it is used.
   ASSERT_EQ(s.warnings.size(), 2u);
@@ -367,6 +367,62 @@ TEST(ScenePbrt, UnknownMaterialAndTextureFallBackWithWarnings) {
     EXPECT_EQ(m.type, MATERIAL_DIFFUSE);
     EXPECT_FLOAT_EQ(m.albedo.x, 0.5f);
   }
+}
+
+TEST(ScenePbrt, DielectricsWithFloatOrNamedGlassIndex) {
+  Scene s = load(
+      std::string(kKeptCamera) + "WorldBegin\n" + "Material \"dielectric\" \"float eta\" 1.33\n" +
+      tri_at("0 0 0  1 0 0  0 1 0") + "Material \"thindielectric\"\n" +
+      tri_at("0 0 0  1 0 0  0 1 0") + "Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n" +
+      tri_at("0 0 0  1 0 0  0 1 0") + "Material \"dielectric\" \"float roughness\" 0.1\n" +
+      tri_at("0 0 0  1 0 0  0 1 0"));
+  ASSERT_EQ(s.triangle_count(), 4u);
+  auto mat = [&](size_t t) { return s.materials[size_t(s.triangle_material[t])].gpu; };
+  EXPECT_EQ(mat(0).type, MATERIAL_DIELECTRIC);
+  EXPECT_FLOAT_EQ(mat(0).ior, 1.33f);
+  EXPECT_EQ(mat(1).type, MATERIAL_THIN_DIELECTRIC);
+  EXPECT_FLOAT_EQ(mat(1).ior, 1.5f);       // pbrt-v4's default
+  EXPECT_NEAR(mat(2).ior, 1.5185f, 1e-4f); // BK7 at 550 nm
+  EXPECT_FLOAT_EQ(mat(3).ior, 1.5f);
+  // The named spectrum (no dispersion) and the roughness (glass is smooth) warn at their lines.
+  ASSERT_EQ(s.warnings.size(), 2u);
+  EXPECT_EQ(s.warnings[0].rfind("t.pbrt:9: ", 0), 0u) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].find("glass-BK7"), std::string::npos) << s.warnings[0];
+  EXPECT_EQ(s.warnings[1].rfind("t.pbrt:11: ", 0), 0u) << s.warnings[1];
+  EXPECT_NE(error_of(std::string(kKeptCamera) +
+                     "WorldBegin\nMaterial \"dielectric\" "
+                     "\"float eta\" -1\n" +
+                     tri_at("0 0 0  1 0 0  0 1 0"))
+                .find("t.pbrt:5: "),
+            std::string::npos);
+}
+
+// A tetrahedron wound outward, subdivided: 4^levels triangles, all facing inward as pbrt-v4's do
+// (its limit normals, Cross(S, T) in loopsubdiv.cpp, point against the winding, and a triangle
+// with vertex normals faces them).
+TEST(ScenePbrt, LoopSubdivisionTessellatesAtLoadFacingPbrtsNormals) {
+  const std::string tet = "\"point3 P\" [1 1 1  1 -1 -1  -1 1 -1  -1 -1 1] "
+                          "\"integer indices\" [0 1 2  0 3 1  0 2 3  1 3 2]";
+  for (int levels : {0, 1, 2}) {
+    Scene s =
+        load(std::string(kKeptCamera) + "WorldBegin\nShape \"loopsubdiv\" \"integer levels\" " +
+             std::to_string(levels) + " " + tet + "\n");
+    ASSERT_EQ(s.triangle_count(), size_t(4) << (2 * levels));
+    EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+    for (size_t t = 0; t < s.triangle_count(); ++t) {
+      float3 a = s.vertices[s.indices[3 * t]], b = s.vertices[s.indices[3 * t + 1]],
+             c = s.vertices[s.indices[3 * t + 2]];
+      // (world = stored + origin; the tetrahedron's centre is the world origin)
+      float3 o = make_float3(float(s.origin.x), float(s.origin.y), float(s.origin.z));
+      float3 n = cross(b - a, c - a), centre = (a + b + c) * (1.0f / 3.0f) + o;
+      EXPECT_LT(dot(n, centre), 0.0f) << "levels " << levels << " triangle " << t;
+    }
+  }
+  EXPECT_NE(error_of(std::string(kKeptCamera) + "WorldBegin\nShape \"loopsubdiv\" " +
+                     "\"point3 P\" [0 0 0  1 0 0  0 1 0  0 0 1] "
+                     "\"integer indices\" [0 1 2  0 1 2  0 1 2]\n")
+                .find("t.pbrt:5: "),
+            std::string::npos);
 }
 
 // ---------------------------------------------------------------------- errors and warnings
