@@ -1,5 +1,6 @@
 #include "cli/compare_command.h"
 
+#include "image/block_agreement.h"
 #include "image/error_stats.h"
 #include "image/image_compare.h"
 #include "image/image_io.h"
@@ -24,6 +25,7 @@ struct CompareArgs {
   std::string mask; // a PNG: white pixels (an emitter in view) are left out of the masked MSE
   double error_scale = 0.0;
   double clamp = 0.0; // > 0: clamp both images to [0, clamp] first
+  int blocks = 0;     // > 0: block-mean agreement over blocks of this many pixels a side
   bool relative = false;
   bool json = false;
 };
@@ -71,6 +73,9 @@ int run_compare(const CompareArgs& a) {
     clear = pixel_error_stats(test, ref, mask);
   }
 
+  std::optional<BlockAgreement> agree;
+  if (a.blocks > 0) agree = block_agreement(test, ref, a.blocks);
+
   double used_scale = 0.0;
   if (!a.error_image.empty()) {
     RgbImage err =
@@ -101,6 +106,14 @@ int run_compare(const CompareArgs& a) {
       j["unmasked_pixels"] = clear->pixels;
       j["top_share"] = all->top_share;
     }
+    if (agree)
+      j["blocks"] = {{"size", a.blocks},
+                     {"counted", agree->blocks},
+                     {"total", agree->all_blocks},
+                     {"image_ratio", agree->image_ratio},
+                     {"median_ratio", agree->median_ratio},
+                     {"within_10_percent", agree->within_10},
+                     {"within_3_percent", agree->within_3}};
     std::printf("%s\n", j.dump(2).c_str());
     return 0;
   }
@@ -119,6 +132,12 @@ int run_compare(const CompareArgs& a) {
   if (all)
     std::printf("pixel MSE  %.6e (all), %.6e (the %zu pixels %s leaves out)\n", all->mse,
                 clear->mse, clear->pixels, a.mask.c_str());
+  if (agree)
+    std::printf("blocks     %dx%d pixels, %zu of %zu brighter than 5%% of the mean: image mean "
+                "ratio %.4f, median block ratio %.4f, %.1f%% of blocks within 10%%, %.1f%% within "
+                "3%%\n",
+                a.blocks, a.blocks, agree->blocks, agree->all_blocks, agree->image_ratio,
+                agree->median_ratio, 100.0 * agree->within_10, 100.0 * agree->within_3);
   if (!a.error_image.empty())
     std::printf("wrote %s (%s error, scale %.4g = white)\n", a.error_image.c_str(),
                 a.relative ? "relative" : "absolute", used_scale);
@@ -145,6 +164,11 @@ CLI::App* add_compare_command(CLI::App& app, std::function<int()>& action) {
                   "Clamp both images to [0, V] before measuring (display-referred error)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", args->json, "Print the results as JSON");
+  cmd->add_option("--blocks", args->blocks,
+                  "Also compare means over N x N pixel blocks (those brighter than 5% of the "
+                  "reference's mean): image and median block ratios, share within 10% and 3% "
+                  "(renders of one scene by different renderers)")
+      ->check(CLI::Range(1, 4096));
   cmd->add_option("--mask", args->mask,
                   "An emitter mask PNG (render --emitter-mask): also report the per-pixel MSE "
                   "over all pixels and over the black ones (no emitter in view)");
