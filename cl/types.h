@@ -85,7 +85,10 @@ typedef struct Material {
   // 0: none, so a zero-initialised Material is untextured.
   int albedo_texture;
   int alpha_texture;
-  int pad0, pad1, pad2;
+  // 1: the surface bounds an object whose inside the scene's medium does not fill (glass in fog,
+  // pbrt-v4's MediumInterface "" "fog"): a ray refracted into it travels outside the medium.
+  int excludes_medium;
+  int pad1, pad2;
 } Material;
 
 // ---------------------------------------------------------------- image textures

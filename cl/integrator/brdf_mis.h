@@ -281,12 +281,13 @@ INLINE void brdf_trace_item(GLOBAL BrdfItem* item, const LightSamplerCtx* ls,
   float3 err;
   float3 y = primitive_hit_point(prim, o, d, h, &err);
   float3 Le = light_emitted_radiance(&ls->lights[light], primitive_normal(prim, y), -d);
-  if (HAS_MEDIUM) Le = Le * volume_transmittance(sc, o, d, h.t); // attenuated on its way
+  int path = (int)float_as_uint_(it.dir.w);
+  if (HAS_MEDIUM && pb->shade_wo[path].w == 0.0f) // attenuated on its way (light_point.h)
+    Le = Le * volume_transmittance(sc, o, d, h.t);
   if (!(max3(Le) > 0.0f)) {
     item->value = zero;
     return;
   }
-  int path = (int)float_as_uint_(it.dir.w);
   BrdfPoint bp = brdf_point(ls, sc, pb, path);
   float pdf_y = light_pdf(&ls->lights[light], bp.P, y);
   float p_B = brdf_light_pmf(ls, &bp, light) * pdf_y;

@@ -56,8 +56,10 @@ INLINE int light_point_from(const SceneBuffers* sc, const PathBuffers* pb, int p
   float dist = length(to);
   if (!(dist > 0.0f)) return 0;
   float tmax = dist - fp_gamma(6) * (max_abs3(s.x) + dist);
-  // Light crossing the medium on its way is attenuated (volume_light.h).
-  if (HAS_MEDIUM) s.Li = s.Li * volume_transmittance(sc, P, to / dist, fmax(tmax, 0.0f));
+  // Light crossing the medium on its way is attenuated (volume_light.h), unless the point lies
+  // inside an object that excludes the medium (a shadow ray cannot leave such an object).
+  if (HAS_MEDIUM && pb->shade_wo[path].w == 0.0f)
+    s.Li = s.Li * volume_transmittance(sc, P, to / dist, fmax(tmax, 0.0f));
   lp->origin = f4_from3(P, fmax(tmax, 0.0f));
   lp->dir = f4_from3(to / dist, uint_as_float_((uint)path));
   lp->s = s;

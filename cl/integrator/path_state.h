@@ -13,7 +13,9 @@
 // clang-format off
 #define PATH_STATE_BUFFERS(X)                                                                      \
   X(float4, ray_o)      /* xyz: origin, w: tmin */                                                 \
-  X(float4, ray_d)      /* xyz: unit direction */                                                  \
+  /* xyz: unit direction, w: 1 if the ray travels inside an object that excludes the medium */  \
+  /* (Material.excludes_medium), else 0 */                                                     \
+  X(float4, ray_d)                                                                                 \
   X(float4, throughput) /* xyz: path throughput beta */                                            \
   X(float4, radiance)   /* xyz: radiance gathered so far */                                        \
   X(uint, rng)          /* PCG state (cl/rng.h) */                                                 \
@@ -28,7 +30,8 @@
   /* against BSDF sampling (the path continues with a BSDF sample and MIS is on), else 0; */       \
   /* BRDF_POINT_FLAG (2): a glossy point of a BRDF sampler (brdf_mis.h) */                        \
   X(float4, shade_f)                                                                               \
-  /* xyz: unit direction towards the viewer (read for glossy materials only) */                    \
+  /* xyz: unit direction towards the viewer (read for glossy materials only), w: ray_d.w of the */ \
+  /* ray that arrived (1: the point lies outside the medium) */                                 \
   X(float4, shade_wo)                                                                              \
   /* xyz: shading normal (on wo's side; the geometric normal when flat), w: material (int bits) */ \
   X(float4, shade_Ns)                                                                              \

@@ -141,7 +141,11 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   }
   pb->shade_N[path] = f4_from3(N, uint_as_float_(light_seed));
   pb->shade_f[path] = f4_from3(beta, mis_flag);
-  pb->shade_wo[path] = f4_from3(wo, 0.0f);
+  // Whether rays leaving on wo's side travel outside the medium: as the ray that arrived, or at a
+  // surface that bounds a medium-free inside (pbrt-v4's MediumInterface), by the side.
+  const float outside_medium =
+      m.excludes_medium ? (dot(Ng, d) > 0.0f ? 1.0f : 0.0f) : pb->ray_d[path].w;
+  pb->shade_wo[path] = f4_from3(wo, outside_medium);
   pb->shade_Ns[path] = f4_from3(Ns, uint_as_float_((uint)prim->material));
   pb->shade_P[path] = f4_from3(P, 0.0f);
   if (black) return out;
@@ -163,7 +167,11 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   if (!(max3(beta) > 0.0f) || !(bs.is_delta || bs.pdf > 0.0f)) return out;
   pb->shade_P[path] = f4_from3(P, bs.is_delta ? 0.0f : bs.pdf);
   pb->ray_o[path] = f4_from3(through ? offset_ray_origin(P_hit, P_err, -N) : P, 0.0f);
-  pb->ray_d[path] = f4_from3(normalize(wi), 0.0f);
+  // Leaving a surface that bounds a medium-free inside, a ray takes the medium of its side (into
+  // the inside: none); elsewhere it keeps the one it had.
+  float next_outside = outside_medium;
+  if (m.excludes_medium) next_outside = dot(wi, Ng) < 0.0f ? 1.0f : 0.0f;
+  pb->ray_d[path] = f4_from3(normalize(wi), next_outside);
   pb->throughput[path] = f4_from3(beta, 0.0f);
   out.x = 1;
   return out;

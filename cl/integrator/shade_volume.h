@@ -33,6 +33,7 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
   float3 d = xyz_of(pb->ray_d[path]);
   float t_hit = h.prim >= 0 ? h.t : FLT_INF;
   pb->seg_o[path] = f4_from3(o, -1.0f);
+  if (pb->ray_d[path].w != 0.0f) return 0; // inside an object that excludes the medium
   float t0 = 0.0f, t1 = 0.0f;
   if (!medium_clip(&m, o, d, t_hit, &t0, &t1) || !(t1 > t0)) return 0;
   float full = t1 - t0; // +inf for a ray that never leaves an unbounded medium

@@ -17,6 +17,7 @@ void Reader::camera(const Token& d, Params& p, const std::string& type) {
                             printable(type)));
   camera_set_ = true;
   camera_loc_ = d.loc;
+  camera_medium_ = gs_.medium_outside; // pbrt-v4: the camera is in the current outside medium
   camera_from_world_ = gs_.ctm;
   bool ok = false;
   Transform wfc = inverse(gs_.ctm, ok);

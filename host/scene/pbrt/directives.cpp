@@ -260,8 +260,20 @@ void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& d
       texture(d, p, name, type, cls, dir);
       return;
     }
-    if (k == "MakeNamedMedium" || k == "MediumInterface" || k == "Attribute" ||
-        k == "ActiveTransform" || k == "TransformTimes" || k == "PixelFilter" ||
+    if (k == "MediumInterface") { // "inside" ["outside"]: one name is both
+      std::vector<std::string> names{one_string(d, lx)};
+      if (!lx.at_directive()) names.push_back(one_string(d, lx));
+      no_args();
+      medium_interface(d, names);
+      return;
+    }
+    if (k == "MakeNamedMedium") {
+      std::string name = one_string(d, lx);
+      Params p(*this, parse_params(lx), fmt::format("MakeNamedMedium \"{}\"", printable(name, 40)));
+      make_named_medium(d, p, name);
+      return;
+    }
+    if (k == "Attribute" || k == "ActiveTransform" || k == "TransformTimes" || k == "PixelFilter" ||
         k == "Accelerator" || k == "ColorSpace") {
       warn(d.loc, fmt::format("{} is not read in this slice, ignored", k));
       skip();
@@ -337,6 +349,7 @@ void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& d
         warn(d.loc, fmt::format("Integrator \"{}\": rendered with Canopy's path tracer, the "
                                 "integrator ignored",
                                 printable(type)));
+      integrator_ = type;
       count_param(p, "maxdepth", kMaxDepth, &scene_.integrator.max_depth);
       p.finish();
     } else if (k == "Shape") {
@@ -373,6 +386,7 @@ void Reader::count_param(Params& p, const char* name, int hi, int* out) {
 void Reader::finish() {
   const Loc end = last_loc_.file ? last_loc_ : Loc{&names_.front(), 1};
   if (!world_block_) finish_camera(end); // a file without WorldBegin: camera and options only
+  finish_media();
   if (!stack_.empty())
     warn(stack_.back().loc,
          fmt::format("{} without its end at the end of the file, ignored", stack_.back().kind));

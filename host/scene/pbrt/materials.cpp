@@ -229,6 +229,11 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
       alpha_texture = 0;
     }
     md = dielectric_material(mname, ior, thin);
+  } else if (type == "interface") {
+    // pbrt-v4's interface bounds a medium and is otherwise invisible: its shapes are not added
+    // (media.cpp renders the medium's extent).
+    md = diffuse_material(mname, make_float3(0, 0, 0));
+    interface_materials_.insert(int(scene_.materials.size()));
   } else {
     warn(loc, fmt::format("Material \"{}\" is not read in this slice (diffuse 0.5 used), ignored",
                           printable(type)));

@@ -25,6 +25,7 @@
 //   light_sources  LightSource and AreaLightSource
 //   textures       Texture and the texture-valued parameters of materials
 //   materials      Material and MakeNamedMaterial
+//   media          MakeNamedMedium, MediumInterface and the camera's medium
 //   load           the public entry points (scene/pbrt_reader.h)
 #pragma once
 
@@ -39,6 +40,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -59,6 +61,14 @@ struct GState {
   bool area = false;    // an AreaLightSource "diffuse" applies to the shapes
   float3 area_L{0, 0, 0};
   bool area_twosided = false;
+  std::string medium_inside, medium_outside; // MediumInterface ("": vacuum)
+};
+
+// A MakeNamedMedium (media.cpp): homogeneous ones are rendered.
+struct NamedMedium {
+  bool homogeneous = false;
+  Medium medium{};
+  Loc loc;
 };
 
 struct ObjectPart {
@@ -114,6 +124,10 @@ private:
   void area_light(const Token& d, Params& p, const std::string& type);
   int material(const Loc& loc, Params& p, const std::string& type, const std::string& name);
   float dielectric_eta(Params& p);
+  void make_named_medium(const Token& d, Params& p, const std::string& name);
+  void medium_interface(const Token& d, const std::vector<std::string>& names);
+  int shape_material(const Loc& loc);
+  void finish_media();
   void texture(const Token& d, Params& p, const std::string& name, const std::string& type,
                const std::string& cls, const std::filesystem::path& dir);
   NamedTexture image_texture(const Loc& loc, Params& p, const std::string& name,
@@ -142,6 +156,12 @@ private:
   std::vector<Pushed> stack_;
   std::map<std::string, Transform> coord_systems_;
   std::map<std::string, int> named_materials_;
+  std::set<int> interface_materials_; // pbrt-v4's "interface": its shapes are not added
+  std::map<std::string, NamedMedium> media_;
+  std::set<std::string> media_used_;
+  std::map<int, int> excluding_materials_; // material -> its copy that excludes the medium
+  std::string camera_medium_;              // the outside medium at the Camera directive
+  std::string integrator_ = "volpath";     // pbrt-v4's default
   // Named textures: global (not scoped by attributes), one namespace per type (pbrt-v4
   // BasicSceneBuilder::Texture).
   std::map<std::string, NamedTexture> float_textures_, spectrum_textures_;

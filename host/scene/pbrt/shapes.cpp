@@ -38,6 +38,12 @@ void Reader::add_mesh(const Loc& loc, Mesh& m, const Transform& ctm) {
 void Reader::shape(const Token& d, Params& p, const std::string& type,
                    const std::filesystem::path& dir) {
   const Loc& loc = d.loc;
+  if (interface_materials_.count(gs_.material)) { // invisible: it only bounds a medium
+    if (gs_.area) warn(loc, "an area light on a shape of material \"interface\" ignored");
+    p.mark_all_used();
+    return;
+  }
+  const int mat = shape_material(loc);
   Mesh m;
   bool analytic_light_done = false;
   // pbrt-v4 does not support area lights on instanced shapes either.
@@ -120,7 +126,7 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
     std::vector<uint32_t> idx = indices(tri ? 3 : 4, m.vertices.size());
     normals(m.vertices.size());
     uvs(m.vertices.size());
-    add_polygons(m, idx, !tri, gs_.material, emission(), gs_.reverse);
+    add_polygons(m, idx, !tri, mat, emission(), gs_.reverse);
   } else if (type == "plymesh") {
     // pbrt-v4 makes bilinear patches of a PLY file's quads; triangles are the same surface for
     // planar quads.
@@ -139,7 +145,7 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
     m.vertices = std::move(ply.positions);
     m.normals = std::move(ply.normals);
     m.uvs = std::move(ply.uv);
-    add_polygons(m, ply.indices, false, gs_.material, emission(), gs_.reverse);
+    add_polygons(m, ply.indices, false, mat, emission(), gs_.reverse);
     // Only used to tessellate for displacement, which is ignored below.
     if (Param* q = p.one("edgelength", {"float"}))
       warn(q->loc, fmt::format("{}: \"float edgelength\" ignored", p.what()));
@@ -203,7 +209,7 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
       m = sph ? sphere_mesh(float(radius)) : disk_mesh(float(radius), float(height));
       float3 em = emission();
       for (size_t t = 0; t < m.triangle_count(); ++t) {
-        m.material[t] = gs_.material;
+        m.material[t] = mat;
         m.emission[t] = em;
       }
       if (gs_.reverse) reverse_winding(m); // spheres keep their outward shading normals
@@ -229,7 +235,7 @@ void Reader::shape(const Token& d, Params& p, const std::string& type,
     m.vertices = std::move(sd.positions);
     for (const float3& n : sd.normals)
       m.normals.push_back(n * -1.0f);
-    add_polygons(m, sd.indices, false, gs_.material, emission(), gs_.reverse);
+    add_polygons(m, sd.indices, false, mat, emission(), gs_.reverse);
   } else {
     warn(loc, fmt::format("Shape \"{}\" is not read in this slice, ignored", printable(type)));
     return;
