@@ -46,6 +46,10 @@ inline constexpr float kMaxPlasticIor = 10.0f;
 inline constexpr float kDefaultPlasticIor = 1.5f;
 // A dielectric's index, inside over outside: below 1 is a bubble (air in water, say).
 inline constexpr float kMinDielectricIor = 0.1f, kMaxDielectricIor = 10.0f;
+// Coated materials (cl/bsdf/layered.h): the slab's thickness in mean free paths (beyond ~100 it
+// is opaque), the walk's depth and samples per evaluation (each costs a walk per shading query).
+inline constexpr float kMaxCoatThickness = 1e4f;
+inline constexpr int kMaxCoatDepth = 1000, kMaxCoatSamples = 64;
 // Largest medium coefficient (per scene unit): sigma * distance stays finite in float over any
 // two points of the scene (2e18 * 1e20 < FLT_MAX), so transmittance underflows to 0, never NaN.
 inline constexpr float kMaxMediumCoefficient = 1e20f;
