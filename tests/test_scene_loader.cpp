@@ -177,6 +177,28 @@ TEST(SceneLoader, CoatedMaterialsAndRoughGlass) {
   EXPECT_FLOAT_EQ(glass.alpha, 0.09f);
 }
 
+// A coated diffuse base's albedo and a coat's roughness may be textures (cl/texture.h replaces
+// Material.albedo and alpha at the hit: the base reflectance and the coat's alpha).
+TEST(SceneLoader, CoatedTextures) {
+  Scene s = load_str(scene_with(R"("materials": [
+      {"name": "cd", "type": "coated_diffuse", "albedo": {"texture": "textures/colours.png"},
+       "roughness": {"texture": "textures/roughness.png"}},
+      {"name": "cc", "type": "coated_conductor", "roughness": {"texture": "textures/roughness.png"}}
+      ])"));
+  ASSERT_EQ(s.textures.size(), 3u);
+  const Material& cd = s.materials[1].gpu;
+  EXPECT_EQ(cd.type, MATERIAL_COATED_DIFFUSE);
+  ASSERT_GT(cd.albedo_texture, 0);
+  ASSERT_GT(cd.alpha_texture, 0);
+  EXPECT_EQ(s.textures[size_t(cd.albedo_texture - 1)].channels, 3);
+  EXPECT_EQ(s.textures[size_t(cd.alpha_texture - 1)].map, TEXTURE_MAP_ALPHA_SQUARE);
+  const Material& cc = s.materials[2].gpu;
+  EXPECT_EQ(cc.type, MATERIAL_COATED_CONDUCTOR);
+  EXPECT_EQ(cc.albedo_texture, 0);
+  ASSERT_GT(cc.alpha_texture, 0);
+  EXPECT_EQ(s.textures[size_t(cc.alpha_texture - 1)].map, TEXTURE_MAP_ALPHA_SQUARE);
+}
+
 TEST(SceneLoader, ConductorPresets) {
   // Every preset loads by name and gives exactly the table's eta and k.
   std::string mats;
