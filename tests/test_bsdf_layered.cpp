@@ -11,7 +11,8 @@
 //   microfacets lose (no light scatters twice between microfacets: Heitz et al. 2016); at alpha
 //   0.1 that is up to ~10% here, mostly at the coat's inner face, which light inside meets at
 //   grazing angles, so there albedo lies in [0.85, 1];
-// - eval integrates to what sampling reflects (with a scattering slab, smooth and rough coat);
+// - eval integrates to what sampling reflects (with a scattering slab, smooth and rough coat), and
+//   per bin of directions;
 // - a smooth coat over a smooth conductor: two interfaces and every inter-reflection at the
 //   refracted angle t, with transmittance T = exp(-thickness / cos t) per crossing:
 //     R = F + (1 - F)^2 Rc T^2 / (1 - F Rc T^2)  (F(o) = F inside at t: Fresnel is symmetric);
@@ -26,6 +27,7 @@
 #include <cmath>
 #include <complex>
 #include <random>
+#include <vector>
 
 using namespace canopy;
 using namespace canopy::test;
@@ -184,6 +186,50 @@ TEST(LayeredEval, IntegratesToSampledAlbedo) {
     double se = std::hypot(integral.se(), a.se());
     EXPECT_NEAR(integral.mean() + specular, a.mean(), 5 * se)
         << "type " << m.type << " alpha " << m.alpha << " base " << m.base_alpha;
+  }
+}
+
+// Per direction too: in each of 8 x 8 bins of (cos theta_i, phi_i), the sampled weight that lands
+// there (E[weight 1{wi in bin}]) equals the integral of f cos over the bin (stratified Monte Carlo
+// of eval), within 5 joint standard errors. Rough coats, so nothing is delta.
+TEST(LayeredEval, MatchesSamplingPerDirection) {
+  const Material cases[] = {make_coated_diffuse(make_float3(0.6f, 0.6f, 0.6f), 1.5f, 0.2f,
+                                                {0.2f, {0.7f, 0.7f, 0.7f}, 0.4f, 50, 1}),
+                            make_coated_conductor(1.5f, 0.15f, make_float3(0.2f, 0.2f, 0.2f),
+                                                  make_float3(3, 3, 3), 0.25f, kClear)};
+  const int nb = 8, n_samples = 400000, n_eval = 4000;
+  for (const Material& m : cases) {
+    const float3 wo = dir_mu(0.5, 0.0);
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+    std::vector<double> sum(nb * nb, 0.0), sum2(nb * nb, 0.0);
+    for (int i = 0; i < n_samples; ++i) {
+      BsdfSample s = bsdf_sample(&m, wo, make_float3(uni(rng), uni(rng), uni(rng)));
+      ASSERT_EQ(s.is_delta, 0);
+      if (!(s.weight.x > 0)) continue;
+      double phi = std::atan2(double(s.wi.y), double(s.wi.x));
+      if (phi < 0) phi += 2 * M_PI;
+      int b =
+          std::min(nb - 1, int(s.wi.z * nb)) * nb + std::min(nb - 1, int(phi / (2 * M_PI) * nb));
+      sum[b] += s.weight.x;
+      sum2[b] += double(s.weight.x) * s.weight.x;
+    }
+    for (int bm = 0; bm < nb; ++bm)
+      for (int bp = 0; bp < nb; ++bp) {
+        const int b = bm * nb + bp;
+        double mean_s = sum[b] / n_samples;
+        double var_s = (sum2[b] / n_samples - mean_s * mean_s) / n_samples;
+        Mean e; // f cos over the bin, area 2 pi / nb^2 in (mu, phi)
+        const double area = 2 * M_PI / (nb * nb);
+        for (int k = 0; k < n_eval; ++k) {
+          double mu = (bm + uni(rng)) / nb, phi = 2 * M_PI * (bp + uni(rng)) / nb;
+          float3 wi = dir_mu(mu, phi);
+          e.add(area * bsdf_eval(&m, wo, wi).x * wi.z);
+        }
+        double se = std::sqrt(std::max(0.0, var_s) + e.se() * e.se());
+        EXPECT_NEAR(mean_s, e.mean(), 5 * se + 1e-5)
+            << "type " << m.type << " bin mu " << bm << " phi " << bp;
+      }
   }
 }
 
