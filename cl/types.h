@@ -66,9 +66,10 @@ typedef struct Light {
 #define MATERIAL_DIFFUSE 0   // Lambertian: albedo / pi
 #define MATERIAL_CONDUCTOR 1 // GGX microfacet with the exact conductor Fresnel of eta + i k
 #define MATERIAL_PLASTIC 2   // albedo / pi + specular * GGX with dielectric Fresnel (pbrt-v3)
-// Smooth glass (pbrt-v4's dielectric with roughness 0): Fresnel reflection and refraction of
-// index `ior`, both delta lobes. The thin one is a sheet: rays pass straight through it, with the
-// reflectance of its two faces and every inter-reflection between them (pbrt-v4's thindielectric).
+// Glass (pbrt-v4's dielectric): Fresnel reflection and refraction of index `ior`, delta lobes at
+// alpha 0, GGX microfacet lobes above. The thin one is a smooth sheet: rays pass straight through
+// it, with the reflectance of its two faces and every inter-reflection between them (pbrt-v4's
+// thindielectric).
 #define MATERIAL_DIELECTRIC 3
 #define MATERIAL_THIN_DIELECTRIC 4
 // pbrt-v4's coateddiffuse and coatedconductor (cl/bsdf/layered.h): a dielectric coat of index
@@ -83,7 +84,8 @@ typedef struct Material {
   float4 specular; // plastic: specular scale rgb; conductor, coated conductor: eta (real part of
                    // the conductor's index) rgb
   float4 k;        // conductor, coated conductor: k (imaginary part of the index) rgb
-  float4 medium;   // coated: albedo rgb of the medium between coat and base (0: none); HG g (w)
+  float4 medium;   // coated: scattering albedo rgb of the layer between coat and base (0: it
+                   // only absorbs); its Henyey-Greenstein g (w)
   float alpha;     // conductor, plastic, dielectric, coat: GGX alpha (0: perfect specular)
   float ior;       // plastic, coated: index of refraction of the coat; dielectrics: their index
                    // (the scene's, inside over outside; shade_surface inverts it from inside)

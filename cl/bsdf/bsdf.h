@@ -1,7 +1,8 @@
 // BSDF interface: evaluation, pdf and sampling of a Material in the local shading frame
 // (z = shading normal, wo.z > 0: the caller flips the frame to face wo). Dispatches on
-// Material.type; the conductor, plastic and dielectric code is compiled only when the kernel has
-// those features (cl/kernel_features.h), so a diffuse-only kernel holds no GGX or Fresnel code.
+// Material.type; the conductor, plastic, dielectric and coated code is compiled only when the
+// kernel has those features (cl/kernel_features.h), so a diffuse-only kernel holds no GGX or
+// Fresnel code.
 //   bsdf_eval   f(wo, wi) of the non-delta lobes (0 below the horizon, except rough glass)
 //   bsdf_pdf    solid-angle pdf of bsdf_sample's non-delta directions
 //   bsdf_sample a direction from u (3 uniforms in [0, 1)): see BsdfSample (bsdf_sample.h); a
@@ -99,7 +100,7 @@ INLINE int bsdf_has_smooth_lobe(const Material* m) {
     return layered_has_smooth_lobe(m);
 #endif
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR))
-    return m->alpha > 0.0f; // not ggx_is_delta: compiled without HAS_MICROFACET too
+    return m->alpha > 0.0f; // not ggx_is_delta: compiled without HAS_GGX too
   return 1;
 }
 
