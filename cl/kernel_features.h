@@ -19,6 +19,7 @@
 #define HAS_MATERIAL_CONDUCTOR 1
 #define HAS_MATERIAL_PLASTIC 1
 #define HAS_MATERIAL_DIELECTRIC 1
+#define HAS_MATERIAL_COATED 1
 #define HAS_MEDIUM 1
 #define HAS_TEXTURES 1
 #endif
@@ -33,12 +34,18 @@
 #define IS_LIGHT(l, T) (HAS_##T ? (l)->type == T : 0)
 #define IS_PRIM(p, T) (HAS_##T ? (p)->type == T : 0)
 #define IS_MATERIAL(m, T) (HAS_##T ? (m)->type == T : 0)
-// GGX code (cl/bsdf/microfacet.h) is compiled only for scenes with a glossy material.
-#define HAS_MICROFACET (HAS_MATERIAL_CONDUCTOR || HAS_MATERIAL_PLASTIC)
-// One feature for both smooth dielectrics (cl/bsdf/dielectric.h).
+// A reflective material with a glossy lobe: where BRDF-oriented light sampling may apply (the
+// BRDF stages exist only for scenes with one, cl/integrator/brdf_mis.h).
+#define HAS_MICROFACET (HAS_MATERIAL_CONDUCTOR || HAS_MATERIAL_PLASTIC || HAS_MATERIAL_COATED)
+// GGX code (cl/bsdf/microfacet.h): the glossy materials and rough glass.
+#define HAS_GGX (HAS_MICROFACET || HAS_MATERIAL_DIELECTRIC)
+// One feature for glass and thin sheets (cl/bsdf/dielectric.h), one for both coated materials
+// (cl/bsdf/layered.h).
 #define HAS_MATERIAL_THIN_DIELECTRIC HAS_MATERIAL_DIELECTRIC
+#define HAS_MATERIAL_COATED_DIFFUSE HAS_MATERIAL_COATED
+#define HAS_MATERIAL_COATED_CONDUCTOR HAS_MATERIAL_COATED
 // Dielectric Fresnel (cl/bsdf/fresnel.h): the glossy materials and glass.
-#define HAS_FRESNEL (HAS_MICROFACET || HAS_MATERIAL_DIELECTRIC)
+#define HAS_FRESNEL HAS_GGX
 // Lights at infinity (cl/types.h): distant or environment lights.
 #define HAS_INFINITE_LIGHT (HAS_LIGHT_DISTANT || HAS_LIGHT_ENVIRONMENT)
 

@@ -66,27 +66,44 @@ typedef struct Light {
 #define MATERIAL_DIFFUSE 0   // Lambertian: albedo / pi
 #define MATERIAL_CONDUCTOR 1 // GGX microfacet with the exact conductor Fresnel of eta + i k
 #define MATERIAL_PLASTIC 2   // albedo / pi + specular * GGX with dielectric Fresnel (pbrt-v3)
-// Smooth glass (pbrt-v4's dielectric with roughness 0): Fresnel reflection and refraction of
-// index `ior`, both delta lobes. The thin one is a sheet: rays pass straight through it, with the
-// reflectance of its two faces and every inter-reflection between them (pbrt-v4's thindielectric).
+// Glass (pbrt-v4's dielectric): Fresnel reflection and refraction of index `ior`, delta lobes at
+// alpha 0, GGX microfacet lobes above. The thin one is a smooth sheet: rays pass straight through
+// it, with the reflectance of its two faces and every inter-reflection between them (pbrt-v4's
+// thindielectric).
 #define MATERIAL_DIELECTRIC 3
 #define MATERIAL_THIN_DIELECTRIC 4
+// pbrt-v4's coateddiffuse and coatedconductor (cl/bsdf/layered.h): a dielectric coat of index
+// `ior` and GGX alpha `alpha` over a Lambertian base of reflectance `albedo`, or over a conductor
+// of index (specular + i k) / ior (the conductor's own index divided by the coat's) and GGX alpha
+// `base_alpha`, with an optional scattering medium between them. Opaque, seen from the top only.
+#define MATERIAL_COATED_DIFFUSE 5
+#define MATERIAL_COATED_CONDUCTOR 6
 
 typedef struct Material {
-  float4 albedo;   // diffuse, plastic: diffuse reflectance rgb in [0,1]
-  float4 specular; // plastic: specular scale rgb; conductor: eta (real part of the index) rgb
-  float4 k;        // conductor: k (imaginary part of the index) rgb
-  float alpha;     // conductor, plastic: GGX alpha = roughness^2 (0: perfect specular)
-  float ior;       // plastic: index of refraction of the coat; dielectrics: their index (the
-                   // scene's, inside over outside; shade_surface inverts it for a ray from inside)
+  float4 albedo;   // diffuse, plastic, coated diffuse: diffuse reflectance rgb in [0,1]
+  float4 specular; // plastic: specular scale rgb; conductor, coated conductor: eta (real part of
+                   // the conductor's index) rgb
+  float4 k;        // conductor, coated conductor: k (imaginary part of the index) rgb
+  float4 medium;   // coated: scattering albedo rgb of the layer between coat and base (0: it
+                   // only absorbs); its Henyey-Greenstein g (w)
+  float alpha;     // conductor, plastic, dielectric, coat: GGX alpha (0: perfect specular)
+  float ior;       // plastic, coated: index of refraction of the coat; dielectrics: their index
+                   // (the scene's, inside over outside; shade_surface inverts it from inside)
   int type;        // MATERIAL_*
   // Image textures (HAS_TEXTURES; cl/texture.h): 1 + the index into the scene's textures of the
   // texture that replaces albedo (rgb) and alpha (a float texture mapped to alpha, Texture::map);
   // 0: none, so a zero-initialised Material is untextured.
   int albedo_texture;
   int alpha_texture;
+  // coated: the medium's thickness (its extinction coefficient is 1: pbrt-v4's sigma_t), the
+  // conductor base's GGX alpha, the random walk's maximum depth and samples per evaluation.
+  float thickness;
+  float base_alpha;
+  int max_depth;
+  int n_samples;
   // 1: the surface bounds an object whose inside the scene's medium does not fill (glass in fog,
-  // pbrt-v4's MediumInterface "" "fog"): a ray refracted into it travels outside the medium.
+  // pbrt-v4's MediumInterface "" "fog"): a ray leaving into that inside travels outside the
+  // medium (shade_surface.h).
   int excludes_medium;
   int pad1, pad2;
 } Material;

@@ -1,8 +1,9 @@
 // cl/bsdf/cap_integral.h compiled as OpenCL C on PoCL against the host (C++) build of the same
 // header: a probe kernel runs cap_lobe_make, cap_lobe_integral and cap_lobe_is_glossy for every
-// material type and a spread of caps (tiny to the whole sphere, straddling the horizon), with
-// every feature on and with each material feature alone (diffuse-only: no GGX code, so the SPTD
-// table is not even included). The accuracy tests are host-side (test_cap_integral.cpp).
+// material type (the coated ones through their stand-in lobes) and a spread of caps (tiny to the
+// whole sphere, straddling the horizon), with every feature on and with each material feature alone
+// (diffuse-only: no GGX code, so the SPTD table is not even included). The accuracy tests are
+// host-side (test_cap_integral.cpp).
 //
 // Tolerance: the device's sqrt, sin, cos, acos and atan2 may differ from glibc's by an ulp or
 // two; a few ulps in the pivot's position move a sharp lobe's (alpha = 0.01) cap integrals by up
@@ -119,6 +120,16 @@ void run(ClRuntime& rt, const std::string& options, const std::vector<Material>&
 Material diffuse() {
   return make_diffuse(make_float3(0.8f, 0.5f, 0.2f));
 }
+// Coated materials get a stand-in plastic or conductor lobe (cap_coated_proxy).
+std::vector<Material> coated() {
+  std::vector<Material> v;
+  for (float a : {0.0f, 0.09f}) {
+    v.push_back(make_coated_diffuse(make_float3(0.6f, 0.3f, 0.1f), 1.5f, a));
+    v.push_back(make_coated_conductor(1.5f, a, make_float3(0.18f, 0.42f, 1.37f),
+                                      make_float3(3.42f, 2.35f, 1.77f), 0.01f));
+  }
+  return v;
+}
 Material conductor(float alpha) { // gold-like
   return make_conductor(make_float3(0.18f, 0.42f, 1.37f), make_float3(3.42f, 2.35f, 1.77f), alpha);
 }
@@ -137,13 +148,16 @@ TEST(KernelCapIntegral, MatchesHost) {
     mats.push_back(conductor(a));
     mats.push_back(plastic(a));
   }
+  for (const Material& m : coated())
+    mats.push_back(m);
   run(rt, "", mats, 1);
 }
 
-std::string features(bool conductor_on, bool plastic_on) {
+std::string features(bool conductor_on, bool plastic_on, bool coated_on = false) {
   KernelFeatures f;
   f.material_conductor = conductor_on;
   f.material_plastic = plastic_on;
+  f.material_coated = coated_on;
   return f.build_options();
 }
 
@@ -154,4 +168,7 @@ TEST(KernelCapIntegral, SpecialisedKernelsMatchHost) {
   run(rt, features(false, false), {diffuse()}, 2); // diffuse only: no GGX code, no table
   run(rt, features(true, false), {diffuse(), conductor(0.01f), conductor(0.5f)}, 3);
   run(rt, features(false, true), {diffuse(), plastic(0.0f), plastic(0.09f)}, 4);
+  std::vector<Material> mats = coated();
+  mats.push_back(diffuse());
+  run(rt, features(false, false, true), mats, 5); // coated alone: its stand-in lobes
 }

@@ -280,7 +280,24 @@ TEST(SceneErrors, DuplicateMaterialName) {
 TEST(SceneErrors, UnknownMaterialType) {
   EXPECT_EQ(error_of(scene_with(R"("materials": [{"name": "m", "type": "glass", "albedo": 1}])")),
             "scene.json: materials[0].type: unknown value \"glass\" (expected one of: diffuse, "
-            "conductor, plastic)");
+            "conductor, plastic, dielectric, coated_diffuse, coated_conductor)");
+}
+
+TEST(SceneErrors, CoatedAndRoughGlassValues) {
+  auto err = [](const std::string& m) {
+    return error_of(scene_with(R"("materials": [)" + m + "]"));
+  };
+  EXPECT_EQ(err(R"({"name": "m", "type": "coated_diffuse", "conductor_roughness": 0.1})"),
+            "scene.json: materials[0].conductor_roughness: unknown key");
+  EXPECT_EQ(err(R"({"name": "m", "type": "coated_conductor", "albedo": 0.5})"),
+            "scene.json: materials[0].albedo: unknown key");
+  EXPECT_EQ(err(R"({"name": "m", "type": "coated_diffuse", "samples": 0})"),
+            "scene.json: materials[0].samples: must be in [1, 64]");
+  EXPECT_EQ(err(R"({"name": "m", "type": "coated_conductor", "metal": "gold", "k": 1})"),
+            "scene.json: materials[0].k: not allowed together with \"metal\" (give a preset or "
+            "eta and k)");
+  EXPECT_EQ(err(R"({"name": "m", "type": "dielectric", "thin": true, "roughness": 0.2})"),
+            "scene.json: materials[0].roughness: a thin dielectric is smooth");
 }
 
 namespace {

@@ -128,6 +128,77 @@ TEST(SceneLoader, ConductorWithEtaAndK) {
   EXPECT_EQ(mirror.k.y, 0.0f);
 }
 
+// Coated materials: pbrt-v4's defaults where absent, roughness r as GGX alpha r^2, the conductor's
+// own index as given (the BSDF divides it by the coat's); rough glass.
+TEST(SceneLoader, CoatedMaterialsAndRoughGlass) {
+  Scene s = load_str(scene_with(R"("materials": [
+      {"name": "cd", "type": "coated_diffuse"},
+      {"name": "cd2", "type": "coated_diffuse", "albedo": [0.1, 0.2, 0.3], "roughness": 0.5,
+       "ior": 1.33, "thickness": 0.2, "medium_albedo": [0.4, 0.5, 0.6], "g": -0.3,
+       "max_depth": 30, "samples": 4},
+      {"name": "cc", "type": "coated_conductor"},
+      {"name": "cc2", "type": "coated_conductor", "roughness": 0.1, "eta": [0.2, 0.5, 1.5],
+       "k": [3.5, 2.5, 1.75], "conductor_roughness": 0.4, "ior": 1.4},
+      {"name": "frosted", "type": "dielectric", "ior": 1.5, "roughness": 0.3}])"));
+  ASSERT_EQ(s.materials.size(), 6u);
+  const Material& cd = s.materials[1].gpu;
+  EXPECT_EQ(cd.type, MATERIAL_COATED_DIFFUSE);
+  EXPECT_FLOAT_EQ(cd.albedo.y, 0.5f); // pbrt-v4: reflectance 0.5, roughness 0, eta 1.5,
+  EXPECT_EQ(cd.alpha, 0.0f);          // thickness 0.01, albedo 0, g 0, maxdepth 10, nsamples 1
+  EXPECT_FLOAT_EQ(cd.ior, 1.5f);
+  EXPECT_FLOAT_EQ(cd.thickness, 0.01f);
+  EXPECT_EQ(cd.medium.x, 0.0f);
+  EXPECT_EQ(cd.medium.w, 0.0f);
+  EXPECT_EQ(cd.max_depth, 10);
+  EXPECT_EQ(cd.n_samples, 1);
+  const Material& cd2 = s.materials[2].gpu;
+  EXPECT_FLOAT_EQ(cd2.albedo.z, 0.3f);
+  EXPECT_FLOAT_EQ(cd2.alpha, 0.25f);
+  EXPECT_FLOAT_EQ(cd2.ior, 1.33f);
+  EXPECT_FLOAT_EQ(cd2.thickness, 0.2f);
+  EXPECT_FLOAT_EQ(cd2.medium.y, 0.5f);
+  EXPECT_FLOAT_EQ(cd2.medium.w, -0.3f);
+  EXPECT_EQ(cd2.max_depth, 30);
+  EXPECT_EQ(cd2.n_samples, 4);
+  const Material& cc = s.materials[3].gpu;
+  const MetalPreset* cu = find_metal_preset("copper"); // pbrt-v4's default conductor: Cu
+  EXPECT_EQ(cc.type, MATERIAL_COATED_CONDUCTOR);
+  EXPECT_EQ(cc.specular.x, cu->eta[0]);
+  EXPECT_EQ(cc.k.z, cu->k[2]);
+  EXPECT_EQ(cc.base_alpha, 0.0f);
+  const Material& cc2 = s.materials[4].gpu;
+  EXPECT_FLOAT_EQ(cc2.alpha, 0.01f);
+  EXPECT_FLOAT_EQ(cc2.base_alpha, 0.16f);
+  EXPECT_FLOAT_EQ(cc2.specular.z, 1.5f);
+  EXPECT_FLOAT_EQ(cc2.k.x, 3.5f);
+  EXPECT_FLOAT_EQ(cc2.ior, 1.4f);
+  const Material& glass = s.materials[5].gpu;
+  EXPECT_EQ(glass.type, MATERIAL_DIELECTRIC);
+  EXPECT_FLOAT_EQ(glass.alpha, 0.09f);
+}
+
+// A coated diffuse base's albedo and a coat's roughness may be textures (cl/texture.h replaces
+// Material.albedo and alpha at the hit: the base reflectance and the coat's alpha).
+TEST(SceneLoader, CoatedTextures) {
+  Scene s = load_str(scene_with(R"("materials": [
+      {"name": "cd", "type": "coated_diffuse", "albedo": {"texture": "textures/colours.png"},
+       "roughness": {"texture": "textures/roughness.png"}},
+      {"name": "cc", "type": "coated_conductor", "roughness": {"texture": "textures/roughness.png"}}
+      ])"));
+  ASSERT_EQ(s.textures.size(), 3u);
+  const Material& cd = s.materials[1].gpu;
+  EXPECT_EQ(cd.type, MATERIAL_COATED_DIFFUSE);
+  ASSERT_GT(cd.albedo_texture, 0);
+  ASSERT_GT(cd.alpha_texture, 0);
+  EXPECT_EQ(s.textures[size_t(cd.albedo_texture - 1)].channels, 3);
+  EXPECT_EQ(s.textures[size_t(cd.alpha_texture - 1)].map, TEXTURE_MAP_ALPHA_SQUARE);
+  const Material& cc = s.materials[2].gpu;
+  EXPECT_EQ(cc.type, MATERIAL_COATED_CONDUCTOR);
+  EXPECT_EQ(cc.albedo_texture, 0);
+  ASSERT_GT(cc.alpha_texture, 0);
+  EXPECT_EQ(s.textures[size_t(cc.alpha_texture - 1)].map, TEXTURE_MAP_ALPHA_SQUARE);
+}
+
 TEST(SceneLoader, ConductorPresets) {
   // Every preset loads by name and gives exactly the table's eta and k.
   std::string mats;

@@ -1,12 +1,15 @@
 // BSDF interface: evaluation, pdf and sampling of a Material in the local shading frame
 // (z = shading normal, wo.z > 0: the caller flips the frame to face wo). Dispatches on
-// Material.type; the conductor, plastic and dielectric code is compiled only when the kernel has
-// those features (cl/kernel_features.h), so a diffuse-only kernel holds no GGX or Fresnel code.
-//   bsdf_eval   f(wo, wi) of the non-delta lobes (0 below the horizon: reflection only)
+// Material.type; the conductor, plastic, dielectric and coated code is compiled only when the
+// kernel has those features (cl/kernel_features.h), so a diffuse-only kernel holds no GGX or
+// Fresnel code.
+//   bsdf_eval   f(wo, wi) of the non-delta lobes (0 below the horizon, except rough glass)
 //   bsdf_pdf    solid-angle pdf of bsdf_sample's non-delta directions
 //   bsdf_sample a direction from u (3 uniforms in [0, 1)): see BsdfSample (bsdf_sample.h); a
 //               dielectric's transmitted direction has wi.z < 0
 //   bsdf_has_smooth_lobe 0 only for a pure delta BSDF (light sampling is then useless)
+// The coated materials' eval and pdf are stochastic estimates, deterministic per (wo, wi)
+// (layered.h).
 // `m` points to a private copy of the material record.
 #ifndef CANOPY_CL_BSDF_BSDF_H
 #define CANOPY_CL_BSDF_BSDF_H
@@ -18,6 +21,7 @@
 #include "conductor.h"
 #include "dielectric.h"
 #include "diffuse.h"
+#include "layered.h"
 #include "plastic.h"
 
 // The material as a ray arriving from inside sees it (from the side its geometric normal points
@@ -34,7 +38,11 @@ INLINE void material_face(Material* m, int from_inside) {
 INLINE float3 bsdf_eval(const Material* m, float3 wo, float3 wi) {
 #if HAS_MATERIAL_DIELECTRIC
   if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC))
-    return make_float3(0.0f, 0.0f, 0.0f);
+    return dielectric_eval(m, wo, wi);
+#endif
+#if HAS_MATERIAL_COATED
+  if (IS_MATERIAL(m, MATERIAL_COATED_DIFFUSE) || IS_MATERIAL(m, MATERIAL_COATED_CONDUCTOR))
+    return layered_eval(m, wo, wi);
 #endif
 #if HAS_MATERIAL_CONDUCTOR
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_eval(m, wo, wi);
@@ -48,7 +56,12 @@ INLINE float3 bsdf_eval(const Material* m, float3 wo, float3 wi) {
 INLINE float bsdf_pdf(const Material* m, float3 wo, float3 wi) {
   (void)m; // diffuse_pdf needs no parameters (unused in a diffuse-only kernel)
 #if HAS_MATERIAL_DIELECTRIC
-  if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC)) return 0.0f;
+  if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC))
+    return dielectric_pdf(m, wo, wi);
+#endif
+#if HAS_MATERIAL_COATED
+  if (IS_MATERIAL(m, MATERIAL_COATED_DIFFUSE) || IS_MATERIAL(m, MATERIAL_COATED_CONDUCTOR))
+    return layered_pdf(m, wo, wi);
 #endif
 #if HAS_MATERIAL_CONDUCTOR
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_pdf(m, wo, wi);
@@ -64,6 +77,10 @@ INLINE BsdfSample bsdf_sample(const Material* m, float3 wo, float3 u) {
   if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC))
     return dielectric_sample(m, wo, u);
 #endif
+#if HAS_MATERIAL_COATED
+  if (IS_MATERIAL(m, MATERIAL_COATED_DIFFUSE) || IS_MATERIAL(m, MATERIAL_COATED_CONDUCTOR))
+    return layered_sample(m, wo, u);
+#endif
 #if HAS_MATERIAL_CONDUCTOR
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return conductor_sample(m, wo, u);
 #endif
@@ -74,9 +91,16 @@ INLINE BsdfSample bsdf_sample(const Material* m, float3 wo, float3 u) {
 }
 
 INLINE int bsdf_has_smooth_lobe(const Material* m) {
-  if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC)) return 0;
+#if HAS_MATERIAL_DIELECTRIC
+  if (IS_MATERIAL(m, MATERIAL_DIELECTRIC) || IS_MATERIAL(m, MATERIAL_THIN_DIELECTRIC))
+    return !dielectric_is_delta(m);
+#endif
+#if HAS_MATERIAL_COATED
+  if (IS_MATERIAL(m, MATERIAL_COATED_DIFFUSE) || IS_MATERIAL(m, MATERIAL_COATED_CONDUCTOR))
+    return layered_has_smooth_lobe(m);
+#endif
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR))
-    return m->alpha > 0.0f; // not ggx_is_delta: compiled without HAS_MICROFACET too
+    return m->alpha > 0.0f; // not ggx_is_delta: compiled without HAS_GGX too
   return 1;
 }
 

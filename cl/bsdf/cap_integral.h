@@ -228,7 +228,33 @@ INLINE void cap_sptd_lookup(float cos_o, float alpha, float* gap_over_alpha, flo
 }
 #endif
 
+#if HAS_MATERIAL_COATED
+// The lobe a coated material (layered.h) gets here: a plastic of the coat's alpha and index over
+// the diffuse base, or a conductor of the base's relative index with the wider of the two alphas.
+// An approximation: it only steers the light pmf, which the estimators divide by.
+INLINE Material cap_coated_proxy(const Material* m) {
+  Material p = *m;
+  if (m->type == MATERIAL_COATED_DIFFUSE) {
+    p.type = MATERIAL_PLASTIC;
+    p.specular = make_float4(1.0f, 1.0f, 1.0f, 0.0f);
+  } else {
+    p.type = MATERIAL_CONDUCTOR;
+    p.specular = m->specular * (1.0f / m->ior);
+    p.k = m->k * (1.0f / m->ior);
+    p.alpha = fmax(m->alpha, m->base_alpha);
+  }
+  return p;
+}
+#endif
+
 INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
+#if HAS_MATERIAL_COATED
+  Material proxy;
+  if (IS_MATERIAL(m, MATERIAL_COATED_DIFFUSE) || IS_MATERIAL(m, MATERIAL_COATED_CONDUCTOR)) {
+    proxy = cap_coated_proxy(m);
+    m = &proxy;
+  }
+#endif
   CapLobe l;
   float3 n = fr->n;
   float cos_o = dot(wo, n);

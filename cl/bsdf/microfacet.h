@@ -1,7 +1,7 @@
 // GGX (Trowbridge-Reitz) microfacet distribution with height-correlated Smith masking-shadowing
 // and visible-normal sampling, in the local shading frame (z = normal). alpha = roughness^2 > 0;
 // callers treat alpha == 0 as a delta lobe and never call these. Compiled only for scenes with a
-// glossy material (HAS_MICROFACET), so a diffuse-only kernel holds no GGX code.
+// glossy material or glass (HAS_GGX), so a diffuse-only kernel holds no GGX code.
 //
 // Every formula is arranged to stay finite for any alpha ggx_alpha gives (>= 1e-7) and for
 // directions at the horizon: no 1 - x cancellations, no tan, no division by a cosine that may be 0.
@@ -11,7 +11,7 @@
 #include "../compat.h"
 #include "../kernel_features.h"
 
-#if HAS_MICROFACET
+#if HAS_GGX
 
 // The alpha the GGX functions get: a positive material alpha is raised to 1e-7 (a lobe far
 // narrower than the float resolution of a direction, ~6e-8) so that alpha^2 and D(n) =
@@ -113,5 +113,5 @@ INLINE float3 reflect_about(float3 wo, float3 h) {
   return h * (2.0f * dot(wo, h)) - wo;
 }
 
-#endif // HAS_MICROFACET
+#endif // HAS_GGX
 #endif // CANOPY_CL_BSDF_MICROFACET_H

@@ -66,9 +66,12 @@ INLINE int brdf_rounds_for(int n) {
 }
 
 // A material with a glossy (GGX, alpha > 0) lobe: where BRDF-oriented sampling applies. A plastic
-// without specular is diffuse.
+// without specular is diffuse. A coated material is glossy with a rough coat (over either base):
+// a smooth coat's mirror reflection is a delta lobe, which these estimators do not sample.
 INLINE int brdf_material_glossy(const Material* m) {
   if (!(m->alpha > 0.0f)) return 0;
+  if (IS_MATERIAL(m, MATERIAL_COATED_DIFFUSE) || IS_MATERIAL(m, MATERIAL_COATED_CONDUCTOR))
+    return 1;
   if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) return 1;
   if (IS_MATERIAL(m, MATERIAL_PLASTIC)) return max3(xyz_of(m->specular)) > 0.0f;
   return 0;

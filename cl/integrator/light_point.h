@@ -33,7 +33,7 @@ INLINE int light_point_from(const SceneBuffers* sc, const PathBuffers* pb, int p
   float3 Ns = xyz_of(pb->shade_Ns[path]);
   float cos_s = dot(Ns, s.wi); // = the local frame's wi.z
   if (!(cos_s > 0.0f)) return 0;
-  if (!HAS_MICROFACET || m.type == MATERIAL_DIFFUSE) {
+  if (!HAS_GGX || m.type == MATERIAL_DIFFUSE) {
     // Lambertian needs no frame (the common case, and the only one of a diffuse-only kernel).
     lp->f_cos =
         diffuse_eval(&m, make_float3(0.0f, 0.0f, 1.0f), make_float3(0.0f, 0.0f, cos_s)) * cos_s;
@@ -45,7 +45,7 @@ INLINE int light_point_from(const SceneBuffers* sc, const PathBuffers* pb, int p
     lp->f_cos = bsdf_eval(&m, wo, wi) * cos_s;
     lp->bsdf_pdf = bsdf_pdf(&m, wo, wi);
   }
-  if (s.is_delta) lp->bsdf_pdf = 0.0f; // BSDF sampling never finds a point light
+  if (s.is_delta) lp->bsdf_pdf = 0.0f;           // BSDF sampling never finds a point light
   if (HAS_INFINITE_LIGHT && s.dist == FLT_INF) { // a light at infinity: an unbounded shadow ray
     lp->origin = f4_from3(P, FLT_INF);
     lp->dir = f4_from3(s.wi, uint_as_float_((uint)path));

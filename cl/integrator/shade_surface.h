@@ -165,7 +165,10 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   beta = beta * bs.weight;
   if (!russian_roulette(&beta, depth, u_rr)) return out;
   if (!(max3(beta) > 0.0f) || !(bs.is_delta || bs.pdf > 0.0f)) return out;
-  pb->shade_P[path] = f4_from3(P, bs.is_delta ? 0.0f : bs.pdf);
+  // 0: emission this ray finds gets full weight. Through rough glass as after a delta bounce: light
+  // samples are taken on wo's side only (light_point.h rejects the far side), so the light
+  // technique cannot produce a path through the surface.
+  pb->shade_P[path] = f4_from3(P, bs.is_delta || through ? 0.0f : bs.pdf);
   pb->ray_o[path] = f4_from3(through ? offset_ray_origin(P_hit, P_err, -N) : P, 0.0f);
   // Leaving a surface that bounds a medium-free inside, a ray takes the medium of its side (into
   // the inside: none); elsewhere it keeps the one it had.

@@ -26,7 +26,7 @@ KernelFeatures KernelFeatures::all(int light_sampler) {
   f.light_point = f.light_spot = f.light_sphere = f.light_quad = f.light_triangle = true;
   f.light_disk = f.light_distant = f.light_environment = true;
   f.prim_sphere = f.prim_disk = true;
-  f.material_conductor = f.material_plastic = f.material_dielectric = true;
+  f.material_conductor = f.material_plastic = f.material_dielectric = f.material_coated = true;
   f.medium = true;
   f.textures = true;
   f.light_sampler = light_sampler;
@@ -40,12 +40,14 @@ std::string KernelFeatures::build_options() const {
       "-DHAS_LIGHT_DISK={} -DHAS_LIGHT_DISTANT={} -DHAS_LIGHT_ENVIRONMENT={} "
       "-DHAS_PRIM_SPHERE={} -DHAS_PRIM_DISK={} "
       "-DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} -DHAS_MATERIAL_DIELECTRIC={} "
+      "-DHAS_MATERIAL_COATED={} "
       "-DHAS_MEDIUM={} -DHAS_TEXTURES={} "
       "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={} -DCANOPY_VOLUME_MIDPOINT={}",
       int(light_point), int(light_spot), int(light_sphere), int(light_quad), int(light_triangle),
       int(light_disk), int(light_distant), int(light_environment), int(prim_sphere), int(prim_disk),
-      int(material_conductor), int(material_plastic), int(material_dielectric), int(medium),
-      int(textures), light_sampler, int(mis), int(volume_midpoint));
+      int(material_conductor), int(material_plastic), int(material_dielectric),
+      int(material_coated), int(medium), int(textures), light_sampler, int(mis),
+      int(volume_midpoint));
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {
@@ -86,6 +88,8 @@ KernelFeatures scene_features(const Scene& scene, int light_sampler) {
     f.material_plastic |= m.gpu.type == MATERIAL_PLASTIC;
     f.material_dielectric |=
         m.gpu.type == MATERIAL_DIELECTRIC || m.gpu.type == MATERIAL_THIN_DIELECTRIC;
+    f.material_coated |=
+        m.gpu.type == MATERIAL_COATED_DIFFUSE || m.gpu.type == MATERIAL_COATED_CONDUCTOR;
     f.textures |= m.gpu.albedo_texture > 0 || m.gpu.alpha_texture > 0;
   }
   return f;

@@ -13,6 +13,7 @@ struct KernelFeatures {
        light_triangle = false, light_disk = false, light_distant = false, light_environment = false;
   bool prim_sphere = false, prim_disk = false;
   bool material_conductor = false, material_plastic = false, material_dielectric = false;
+  bool material_coated = false; // coated diffuse and coated conductor (cl/bsdf/layered.h)
   bool medium = false;          // a participating medium (cl/volume/, shade_volume)
   bool textures = false;        // a material with an image texture (cl/texture.h)
   bool volume_midpoint = false; // medium segments ranked at their midpoint (ablation)

@@ -180,7 +180,8 @@ void Renderer::compile_kernels() {
   features.volume_midpoint = scene_.has_medium && scene_.integrator.volume_importance == "midpoint";
   features.mis = options_.mis;
   brdf_stages_ =
-      sampler_.brdf_oriented() && (features.material_conductor || features.material_plastic);
+      sampler_.brdf_oriented() &&
+      (features.material_conductor || features.material_plastic || features.material_coated);
   // Kernels with the medium feature run shade_volume (on a scene without a medium, its record is
   // vacuum: every path passes unchanged, so forcing the feature on changes no image).
   volume_stages_ = features.medium;

@@ -46,6 +46,10 @@ inline constexpr float kMaxPlasticIor = 10.0f;
 inline constexpr float kDefaultPlasticIor = 1.5f;
 // A dielectric's index, inside over outside: below 1 is a bubble (air in water, say).
 inline constexpr float kMinDielectricIor = 0.1f, kMaxDielectricIor = 10.0f;
+// Coated materials (cl/bsdf/layered.h): the slab's thickness in mean free paths (beyond ~100 it
+// is opaque), the walk's depth and samples per evaluation (each costs a walk per shading query).
+inline constexpr float kMaxCoatThickness = 1e4f;
+inline constexpr int kMaxCoatDepth = 1000, kMaxCoatSamples = 64;
 // Largest medium coefficient (per scene unit): sigma * distance stays finite in float over any
 // two points of the scene (2e18 * 1e20 < FLT_MAX), so transmittance underflows to 0, never NaN.
 inline constexpr float kMaxMediumCoefficient = 1e20f;
@@ -166,13 +170,67 @@ inline MaterialDesc plastic_material(std::string name, float3 albedo, float3 spe
   return d;
 }
 
-// Smooth glass of index `ior` (inside over outside; cl/bsdf/dielectric.h), or a thin sheet of it.
-inline MaterialDesc dielectric_material(std::string name, float ior, bool thin) {
+// Glass of index `ior` (inside over outside; cl/bsdf/dielectric.h), smooth or rough (GGX alpha
+// `alpha`, e.g. pbrt-v4's remapped roughness; 0: smooth), or a thin sheet of it (always smooth).
+inline MaterialDesc dielectric_material(std::string name, float ior, bool thin,
+                                        float alpha = 0.0f) {
   MaterialDesc d;
   d.name = std::move(name);
   d.gpu = Material{};
   d.gpu.ior = ior;
+  d.gpu.alpha = thin ? 0.0f : alpha;
   d.gpu.type = thin ? MATERIAL_THIN_DIELECTRIC : MATERIAL_DIELECTRIC;
+  return d;
+}
+
+// The slab between the coat and the base of a coated material (cl/bsdf/layered.h) and the limits
+// of its random walk; the defaults are pbrt-v4's.
+struct CoatLayer {
+  float thickness = 0.01f;   // in mean free paths: the medium's extinction is 1 per unit
+  float3 albedo = {0, 0, 0}; // the medium's scattering albedo rgb; 0: it only absorbs
+  float g = 0.0f;            // its Henyey-Greenstein asymmetry, in (-1, 1)
+  int max_depth = 10;        // bounces of a walk at most
+  int n_samples = 1;         // walks per evaluation of f and of the pdf
+};
+
+inline void set_coat_layer(Material& m, const CoatLayer& layer) {
+  m.medium = make_float4(layer.albedo.x, layer.albedo.y, layer.albedo.z, layer.g);
+  m.thickness = layer.thickness;
+  m.max_depth = layer.max_depth;
+  m.n_samples = layer.n_samples;
+}
+
+// pbrt-v4's coateddiffuse: a dielectric coat of index `eta` and GGX alpha `alpha` (0: smooth; the
+// caller remaps pbrt's roughness) over a Lambertian base of reflectance `reflectance`.
+inline MaterialDesc coated_diffuse_material(std::string name, float3 reflectance, float alpha,
+                                            float eta, const CoatLayer& layer = {}) {
+  MaterialDesc d;
+  d.name = std::move(name);
+  d.gpu = Material{};
+  d.gpu.albedo = make_float4(reflectance.x, reflectance.y, reflectance.z, 0.0f);
+  d.gpu.alpha = alpha;
+  d.gpu.ior = eta;
+  d.gpu.type = MATERIAL_COATED_DIFFUSE;
+  set_coat_layer(d.gpu, layer);
+  return d;
+}
+
+// pbrt-v4's coatedconductor: a dielectric coat (index `eta`, GGX alpha `alpha`) over a conductor
+// of complex index conductor_eta + i conductor_k (its index in vacuum, per RGB channel: the BSDF
+// divides it by the coat's, as pbrt-v4's material does) and GGX alpha `conductor_alpha`.
+inline MaterialDesc coated_conductor_material(std::string name, float alpha, float eta,
+                                              float3 conductor_eta, float3 conductor_k,
+                                              float conductor_alpha, const CoatLayer& layer = {}) {
+  MaterialDesc d;
+  d.name = std::move(name);
+  d.gpu = Material{};
+  d.gpu.alpha = alpha;
+  d.gpu.ior = eta;
+  d.gpu.specular = make_float4(conductor_eta.x, conductor_eta.y, conductor_eta.z, 0.0f);
+  d.gpu.k = make_float4(conductor_k.x, conductor_k.y, conductor_k.z, 0.0f);
+  d.gpu.base_alpha = conductor_alpha;
+  d.gpu.type = MATERIAL_COATED_CONDUCTOR;
+  set_coat_layer(d.gpu, layer);
   return d;
 }
 

@@ -408,6 +408,40 @@ float parse_roughness(const JsonValue& v, Builder& b, MaterialDesc& d) {
   return 0.5f; // the material's constant, unused where the texture applies
 }
 
+// A conductor's complex index: "metal" (a preset name) or "eta" and "k"; without any of them, the
+// preset `fallback` (nullptr: one is required).
+void parse_conductor_index(const JsonObject& o, float3* eta, float3* k, const char* fallback) {
+  auto metal = o.get("metal");
+  auto e = o.get("eta");
+  auto kv = o.get("k");
+  if (metal) {
+    // The message names eta if both eta and k are given.
+    for (const auto& x : {e, kv})
+      if (x) x->fail("not allowed together with \"metal\" (give a preset or eta and k)");
+  }
+  if (metal || (!e && !kv && fallback)) {
+    const MetalPreset* p = metal ? find_metal_preset(metal->as_enum(metal_preset_names()))
+                                 : find_metal_preset(fallback);
+    *eta = make_float3(p->eta[0], p->eta[1], p->eta[2]);
+    *k = make_float3(p->k[0], p->k[1], p->k[2]);
+    return;
+  }
+  if (!e && !kv) o.fail("a conductor needs \"metal\" (a preset name) or \"eta\" and \"k\"");
+  *eta = o.req("eta").as_color_in(kMinConductorEta, kMaxConductorIndex);
+  *k = o.req("k").as_color_in(0.0f, kMaxConductorIndex);
+}
+
+// The slab and walk of a coated material (pbrt-v4's defaults where absent).
+CoatLayer parse_coat_layer(const JsonObject& o) {
+  CoatLayer l;
+  if (auto x = o.get("thickness")) l.thickness = x->as_float_in(0.0f, kMaxCoatThickness);
+  if (auto x = o.get("medium_albedo")) l.albedo = x->as_albedo();
+  if (auto x = o.get("g")) l.g = x->as_float_in(-1.0f, 1.0f);
+  if (auto x = o.get("max_depth")) l.max_depth = int(x->as_int(1, kMaxCoatDepth));
+  if (auto x = o.get("samples")) l.n_samples = int(x->as_int(1, kMaxCoatSamples));
+  return l;
+}
+
 // One entry of "materials" (docs/scene-format.md, Materials). Roughness r becomes GGX alpha = r^2.
 // "albedo" and "roughness" may be image textures.
 MaterialDesc parse_material(const JsonValue& v, Builder& b) {
@@ -416,7 +450,9 @@ MaterialDesc parse_material(const JsonValue& v, Builder& b) {
   std::string name = nv.as_string();
   if (name.empty()) nv.fail("must not be empty");
   std::string type = "diffuse"; // the default keeps scenes written before glossy materials valid
-  if (auto t = o.get("type")) type = t->as_enum({"diffuse", "conductor", "plastic", "dielectric"});
+  if (auto t = o.get("type"))
+    type = t->as_enum(
+        {"diffuse", "conductor", "plastic", "dielectric", "coated_diffuse", "coated_conductor"});
   if (type == "diffuse") {
     o.allow({"name", "type", "albedo"});
     MaterialDesc d = diffuse_material(name, make_float3(0, 0, 0));
@@ -428,32 +464,54 @@ MaterialDesc parse_material(const JsonValue& v, Builder& b) {
     MaterialDesc d{};
     float r = parse_roughness(o.req("roughness"), b, d);
     const int alpha_texture = d.gpu.alpha_texture;
-    auto metal = o.get("metal");
-    auto eta = o.get("eta");
-    auto k = o.get("k");
-    if (metal) {
-      // The message names eta if both eta and k are given.
-      for (const auto& x : {eta, k})
-        if (x) x->fail("not allowed together with \"metal\" (give a preset or eta and k)");
-      const MetalPreset* p = find_metal_preset(metal->as_enum(metal_preset_names()));
-      d = conductor_material(name, r, make_float3(p->eta[0], p->eta[1], p->eta[2]),
-                             make_float3(p->k[0], p->k[1], p->k[2]));
-    } else {
-      if (!eta && !k) o.fail("a conductor needs \"metal\" (a preset name) or \"eta\" and \"k\"");
-      float3 e = o.req("eta").as_color_in(kMinConductorEta, kMaxConductorIndex);
-      float3 kk = o.req("k").as_color_in(0.0f, kMaxConductorIndex);
-      d = conductor_material(name, r, e, kk);
-    }
+    float3 e, kk;
+    parse_conductor_index(o, &e, &kk, nullptr);
+    d = conductor_material(name, r, e, kk);
     d.gpu.alpha_texture = alpha_texture;
     return d;
   }
   if (type == "dielectric") {
-    o.allow({"name", "type", "ior", "thin"});
+    o.allow({"name", "type", "ior", "thin", "roughness"});
     float ior = kDefaultPlasticIor;
     if (auto i = o.get("ior")) ior = i->as_float_in(kMinDielectricIor, kMaxDielectricIor);
     bool thin = false;
     if (auto t = o.get("thin")) thin = t->as_bool();
-    return dielectric_material(name, ior, thin);
+    float r = 0.0f;
+    if (auto rv = o.get("roughness")) {
+      if (thin) rv->fail("a thin dielectric is smooth");
+      r = rv->as_float_in(0.0f, 1.0f);
+    }
+    return dielectric_material(name, ior, thin, r * r);
+  }
+  if (type == "coated_diffuse" || type == "coated_conductor") {
+    const bool diffuse = type == "coated_diffuse";
+    if (diffuse)
+      o.allow({"name", "type", "albedo", "roughness", "ior", "thickness", "medium_albedo", "g",
+               "max_depth", "samples"});
+    else
+      o.allow({"name", "type", "roughness", "ior", "metal", "eta", "k", "conductor_roughness",
+               "thickness", "medium_albedo", "g", "max_depth", "samples"});
+    MaterialDesc t{}; // the textures
+    float r = 0.0f;
+    if (auto rv = o.get("roughness")) r = parse_roughness(*rv, b, t);
+    float ior = kDefaultPlasticIor;
+    if (auto i = o.get("ior")) ior = i->as_float_in(1.0f, kMaxPlasticIor);
+    CoatLayer layer = parse_coat_layer(o);
+    MaterialDesc d;
+    if (diffuse) {
+      t.gpu.albedo = make_float4(0.5f, 0.5f, 0.5f, 0.0f);
+      if (auto a = o.get("albedo")) parse_albedo(*a, b, t);
+      d = coated_diffuse_material(name, xyz_of(t.gpu.albedo), r * r, ior, layer);
+      d.gpu.albedo_texture = t.gpu.albedo_texture;
+    } else {
+      float3 e, kk;
+      parse_conductor_index(o, &e, &kk, "copper");
+      float cr = 0.0f;
+      if (auto c = o.get("conductor_roughness")) cr = c->as_float_in(0.0f, 1.0f);
+      d = coated_conductor_material(name, r * r, ior, e, kk, cr * cr, layer);
+    }
+    d.gpu.alpha_texture = t.gpu.alpha_texture;
+    return d;
   }
   // plastic
   o.allow({"name", "type", "albedo", "specular", "roughness", "ior"});

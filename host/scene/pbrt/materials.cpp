@@ -53,18 +53,27 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
   // TEXTURE_MAP_VALUE without remapping); the returned constant is then unused.
   using K = NamedTexture::Kind;
   int albedo_texture = 0, alpha_texture = 0;
-  auto roughness = [&]() -> float {
+  // `prefix`: "" or pbrt-v4's "interface." / "conductor." of coatedconductor; a texture is read
+  // only where `textured` (the material's one alpha texture), else warned about.
+  auto roughness = [&](const std::string& prefix = "", bool textured = true) -> float {
     // pbrt-v4: uroughness and vroughness, each defaulting to roughness (itself 0).
     struct Rough {
       double value = 0.0;
       const NamedTexture* image = nullptr; // in float_textures_ (stable)
       const Param* param = nullptr;
     };
-    auto get = [&](const char* key) -> std::optional<Rough> {
+    auto get = [&](const std::string& k) -> std::optional<Rough> {
+      const std::string key = prefix + k;
       Param* q = p.find(key);
       if (!q) return std::nullopt;
       if (q->type != "texture") return Rough{p.get_float(key, 0.0), nullptr, q};
       std::optional<NamedTexture> t = texture_param(p, key, true);
+      if (t->kind == K::Image && !textured) {
+        warn(q->loc, fmt::format("{}: \"texture {}\": an image only for the coat's roughness, "
+                                 "0 used",
+                                 p.what(), key));
+        return Rough{0.0, nullptr, q};
+      }
       if (t->kind == K::Image) return Rough{0.0, &float_textures_.at(q->strs[0]), q};
       return Rough{t->kind == K::Constant ? double(t->value.x) : 0.0, nullptr, q};
     };
@@ -115,12 +124,10 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
   for (const char* skip : {"displacement", "normalmap"})
     if (Param* q = p.find(skip))
       warn(q->loc, fmt::format("{}: \"{} {}\" ignored", p.what(), q->type, skip));
-  MaterialDesc md;
-  if (type == "diffuse") {
-    md = diffuse_material(mname, albedo("reflectance"));
-  } else if (type == "conductor") {
-    float r = roughness();
-    float3 eta, k;
+  // A conductor's index eta + i k (pbrt-v4 ConductorMaterial; `prefix` "conductor." for
+  // coatedconductor): its "reflectance" if given, else its eta and k (named metal spectra map to
+  // Canopy's presets), copper by default.
+  auto conductor_index = [&](const std::string& prefix, float3& eta, float3& k) {
     // A textured "reflectance": only a constant texture is read (an image warns, and the
     // default conductor, eta and k, is used).
     std::optional<float3> refl;
@@ -148,7 +155,8 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
     } else {
       // Named spectra "metal-<X>-eta"/"metal-<X>-k" (pbrt-v4 spectrum.cpp) map to Canopy's
       // measured presets (metal_presets.cpp); copper is pbrt's default conductor.
-      auto preset_of = [&](const std::string& spec, const char* which) -> const MetalPreset* {
+      auto preset_of = [&](const std::string& spec, const std::string& key,
+                           const char* which) -> const MetalPreset* {
         static const std::map<std::string, std::string> m = {
             {"Au", "gold"}, {"Ag", "silver"}, {"Cu", "copper"}, {"Al", "aluminium"}};
         std::string pre = "metal-", suf = std::string("-") + which;
@@ -157,7 +165,7 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
           auto it = m.find(spec.substr(pre.size(), spec.size() - pre.size() - suf.size()));
           if (it != m.end()) return find_metal_preset(it->second);
         }
-        warn(p.find(which)->loc,
+        warn(p.find(key)->loc,
              fmt::format("{}: spectrum \"{}\" has no Canopy preset (gold, silver, copper, "
                          "aluminium): copper used, the spectrum ignored",
                          p.what(), printable(spec)));
@@ -167,17 +175,17 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
       eta = make_float3(cu->eta[0], cu->eta[1], cu->eta[2]);
       k = make_float3(cu->k[0], cu->k[1], cu->k[2]);
       std::string named;
-      if (auto e = p.spectrum("eta", Params::Use::Reflectance, &named)) {
+      if (auto e = p.spectrum(prefix + "eta", Params::Use::Reflectance, &named)) {
         eta = *e;
       } else if (!named.empty()) {
-        const MetalPreset* pr = preset_of(named, "eta");
+        const MetalPreset* pr = preset_of(named, prefix + "eta", "eta");
         eta = make_float3(pr->eta[0], pr->eta[1], pr->eta[2]);
       }
       named.clear();
-      if (auto e = p.spectrum("k", Params::Use::Reflectance, &named)) {
+      if (auto e = p.spectrum(prefix + "k", Params::Use::Reflectance, &named)) {
         k = *e;
       } else if (!named.empty()) {
-        const MetalPreset* pr = preset_of(named, "k");
+        const MetalPreset* pr = preset_of(named, prefix + "k", "k");
         k = make_float3(pr->k[0], pr->k[1], pr->k[2]);
       }
       auto in = [](float3 c, float lo, float hi) {
@@ -189,46 +197,71 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
       if (!in(k, 0.0f, kMaxConductorIndex))
         fail(loc, fmt::format("{}: k must be in [0, {}]", p.what(), kMaxConductorIndex));
     }
-    md = conductor_material(mname, r, eta, k);
-  } else if (type == "coateddiffuse") {
-    // pbrt-v4 CoatedDiffuse is a dielectric coat (index eta) over a Lambertian base, with light
-    // bouncing between the two simulated stochastically. Canopy's plastic is the same pair of
-    // lobes added without that coupling: the specular GGX lobe with the coat's Fresnel
-    // reflectance and roughness matches; the diffuse part is lighter and less saturated than
-    // pbrt's (which loses energy to the coat's internal reflection and tints it by repeated
-    // bounces). The coat medium (albedo, thickness, g) is not modelled.
-    float3 kd = albedo("reflectance");
+  };
+  MaterialDesc md;
+  if (type == "diffuse") {
+    md = diffuse_material(mname, albedo("reflectance"));
+  } else if (type == "conductor") {
     float r = roughness();
+    float3 eta, k;
+    conductor_index("", eta, k);
+    md = conductor_material(mname, r, eta, k);
+  } else if (type == "coateddiffuse" || type == "coatedconductor") {
+    // pbrt-v4's layered materials: a dielectric coat over a Lambertian or conductor base, with a
+    // random walk between them (cl/bsdf/layered.h), with pbrt-v4's parameters and defaults.
+    const bool conductor = type == "coatedconductor";
+    float r = roughness(conductor ? "interface." : "");
     double eta = kDefaultPlasticIor;
-    if (Param* q = p.find("eta")) {
+    const std::string eta_key = conductor ? "interface.eta" : "eta";
+    if (Param* q = p.find(eta_key)) {
       if (q->type == "float") {
-        eta = p.get_float("eta", kDefaultPlasticIor);
+        eta = p.get_float(eta_key, kDefaultPlasticIor);
         if (!(eta >= 1.0 && eta <= kMaxPlasticIor))
-          fail(q->loc,
-               fmt::format("{}: \"float eta\": must be in [1, {}]", p.what(), kMaxPlasticIor));
+          fail(q->loc, fmt::format("{}: \"float {}\": must be in [1, {}]", p.what(), eta_key,
+                                   kMaxPlasticIor));
       } else {
-        warn(q->loc,
-             fmt::format("{}: a spectral \"eta\" ({} used) ignored", p.what(), kDefaultPlasticIor));
+        warn(q->loc, fmt::format("{}: a spectral \"{}\" ({} used) ignored", p.what(), eta_key,
+                                 kDefaultPlasticIor));
       }
     }
-    if (Param* q = p.find("albedo"))
-      warn(q->loc, fmt::format("{}: \"albedo\" of the coat medium ignored", p.what()));
-    for (const char* skip : {"thickness", "g", "maxdepth", "nsamples"})
-      if (Param* q = p.find(skip))
-        warn(q->loc, fmt::format("{}: \"{}\" (the coat's random walk) ignored", p.what(), skip));
-    md = plastic_material(mname, kd, make_float3(1, 1, 1), r, float(eta));
+    CoatLayer layer;
+    double thickness = p.get_float("thickness", 0.01), g = p.get_float("g", 0.0);
+    if (!(thickness >= 0.0 && thickness <= 1e4))
+      fail(loc, fmt::format("{}: \"float thickness\": must be in [0, 10000]", p.what()));
+    if (!(g >= -1.0 && g <= 1.0))
+      fail(loc, fmt::format("{}: \"float g\": must be in [-1, 1]", p.what()));
+    layer.thickness = float(thickness);
+    layer.g = float(g);
+    if (p.find("albedo"))
+      layer.albedo =
+          clamp01(p.spectrum("albedo", Params::Use::Reflectance).value_or(make_float3(0, 0, 0)));
+    int depth = 10, samples = 1;
+    if (Param* q = p.one("maxdepth", {"integer"})) {
+      if (!(q->nums[0] >= 1 && q->nums[0] <= 1000))
+        fail(q->loc, fmt::format("{}: \"integer maxdepth\": must be in [1, 1000]", p.what()));
+      depth = int(q->nums[0]);
+    }
+    if (Param* q = p.one("nsamples", {"integer"})) {
+      if (!(q->nums[0] >= 1 && q->nums[0] <= 64))
+        fail(q->loc, fmt::format("{}: \"integer nsamples\": must be in [1, 64]", p.what()));
+      samples = int(q->nums[0]);
+    }
+    layer.max_depth = depth;
+    layer.n_samples = samples;
+    if (conductor) {
+      float rc = roughness("conductor.", false);
+      float3 ceta, ck;
+      conductor_index("conductor.", ceta, ck);
+      md = coated_conductor_material(mname, r * r, float(eta), ceta, ck, rc * rc, layer);
+    } else {
+      md = coated_diffuse_material(mname, albedo("reflectance"), r * r, float(eta), layer);
+    }
   } else if (type == "dielectric" || type == "thindielectric") {
     const bool thin = type == "thindielectric";
     float ior = dielectric_eta(p);
-    if (!thin) {
-      float r = roughness();
-      if (r > 0.0f || alpha_texture)
-        warn(loc, fmt::format("{}: a rough dielectric is rendered smooth (Canopy's glass is "
-                              "smooth), the roughness ignored",
-                              p.what()));
-      alpha_texture = 0;
-    }
-    md = dielectric_material(mname, ior, thin);
+    // pbrt-v4's thin dielectric is smooth; the dielectric may be rough (GGX).
+    float r = thin ? 0.0f : roughness();
+    md = dielectric_material(mname, ior, thin, r * r);
   } else if (type == "interface") {
     // pbrt-v4's interface bounds a medium and is otherwise invisible: its shapes are not added
     // (media.cpp renders the medium's extent).
