@@ -10,6 +10,7 @@
 // - eval and pdf are 0 and there is no smooth lobe (light sampling skips glass);
 // - index 1 passes every sample straight on.
 #include "bsdf/bsdf.h"
+#include "support/fresnel_reference.h"
 #include "support/materials.h"
 
 #include <gtest/gtest.h>
@@ -21,16 +22,6 @@ using namespace canopy;
 using namespace canopy::test;
 
 namespace {
-
-// Unpolarised reflectance of a smooth interface, light from the side of index 1 onto index eta.
-double ref_fresnel(double cos_i, double eta) {
-  double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1) return 1; // total internal reflection
-  double cos_t = std::sqrt(1 - sin2_t);
-  double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  return 0.5 * (rs * rs + rp * rp);
-}
 
 float3 wo_at(double theta_deg, double phi) {
   double t = theta_deg * M_PI / 180;

@@ -20,6 +20,7 @@
 //   bsdf_pdf at its direction; nothing below the horizon.
 // Stochastic estimates are compared within 5 standard errors of their own sample variance.
 #include "bsdf/bsdf.h"
+#include "support/fresnel_reference.h"
 #include "support/materials.h"
 
 #include <gtest/gtest.h>
@@ -33,15 +34,6 @@ using namespace canopy;
 using namespace canopy::test;
 
 namespace {
-
-double ref_fresnel(double cos_i, double eta) {
-  double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1) return 1;
-  double cos_t = std::sqrt(1 - sin2_t);
-  double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  return 0.5 * (rs * rs + rp * rp);
-}
 
 // A conductor of complex relative index n = eta + i k (Born & Wolf §14.2), complex arithmetic.
 double ref_fresnel_conductor(double cos_i, double eta, double k) {

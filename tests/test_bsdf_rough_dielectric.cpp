@@ -11,6 +11,7 @@
 //   refracted directions obey Snell's law;
 // - there is a smooth lobe, and eval, pdf and sample stay finite at grazing angles.
 #include "bsdf/bsdf.h"
+#include "support/fresnel_reference.h"
 #include "support/materials.h"
 
 #include <gtest/gtest.h>
@@ -23,15 +24,6 @@ using namespace canopy;
 using namespace canopy::test;
 
 namespace {
-
-double ref_fresnel(double cos_i, double eta) {
-  double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1) return 1;
-  double cos_t = std::sqrt(1 - sin2_t);
-  double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  return 0.5 * (rs * rs + rp * rp);
-}
 
 float3 dir_at(double theta_deg, double phi) {
   double t = theta_deg * M_PI / 180;

@@ -20,7 +20,8 @@ using ld = long double;
 
 // Largest dot(n, P - x) over the emitter's vertices (exact enough in long double): > 0 iff the
 // one-sided emitter sends light to P (a linear function is largest at a vertex). A disk emits
-// towards P iff dot(n, P - centre) > 0 (cl/lights/light_sample.h): its distance is that of the centre.
+// towards P iff dot(n, P - centre) > 0 (cl/lights/light_sample.h): its distance is that of the
+// centre.
 ld front_distance(const Light& l, float3 P) {
   const ld n[3] = {l.n.x, l.n.y, l.n.z};
   if (l.type == LIGHT_DISK) {

@@ -20,6 +20,7 @@
 #include "scene/scene.h"
 
 #include "support/double3.h"
+#include "support/fresnel_reference.h"
 
 #include <gtest/gtest.h>
 
@@ -30,17 +31,9 @@
 #include <string>
 
 using namespace canopy;
+using namespace canopy::test;
 
 namespace {
-
-double ref_fresnel(double cos_i, double eta) {
-  double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1) return 1;
-  double cos_t = std::sqrt(1 - sin2_t);
-  double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  return 0.5 * (rs * rs + rp * rp);
-}
 
 double internal_reflectance(double eta) {
   const int n = 100000;

@@ -15,6 +15,8 @@
 // from theta by at most 0.7 deg, which moves R by less than a tenth of the bound.
 #include "render/renderer.h"
 #include "scene/scene.h"
+#include "support/film_stats.h"
+#include "support/fresnel_reference.h"
 
 #include <gtest/gtest.h>
 
@@ -24,26 +26,15 @@
 #include <string>
 
 using namespace canopy;
+using namespace canopy::test;
 
 namespace {
 
-double ref_fresnel(double cos_i, double eta) {
-  double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1) return 1;
-  double cos_t = std::sqrt(1 - sin2_t);
-  double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  return 0.5 * (rs * rs + rp * rp);
-}
-
-struct Stats {
-  double mean = 0, se = 0;
-};
-
 // The scene: the slab (or sheet) in the plane z = 0, the camera 5 units away at angle theta from
 // the normal in the y-z plane; emitters of radiance 1 at z = -2 facing +z and at z = +8 facing -z.
-Stats render_glass(ClRuntime& rt, double theta_deg, double ior, bool thin, bool behind, bool front,
-                   const std::string& sampler, double roughness = 0, int spp = 256) {
+SampleStats render_glass(ClRuntime& rt, double theta_deg, double ior, bool thin, bool behind,
+                         bool front, const std::string& sampler, double roughness = 0,
+                         int spp = 256) {
   const double t = theta_deg * M_PI / 180;
   std::string shape =
       thin ? R"({"type": "quad", "material": "glass", "corner": [-6, -6, 0], "edge1": [12, 0, 0],
@@ -78,17 +69,8 @@ Stats render_glass(ClRuntime& rt, double theta_deg, double ior, bool thin, bool 
   rs.seed = 11;
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
-  // Over every sample of the green channel (the scene is grey).
-  double n = 0, s = 0, s2 = 0;
-  for (size_t p = 0; p < film.sum.size(); ++p) {
-    n += film.sum[p].w;
-    s += film.sum[p].y;
-    s2 += film.sumsq[p].y;
-  }
-  Stats st;
-  st.mean = s / n;
-  st.se = std::sqrt(std::max(0.0, s2 / n - st.mean * st.mean) / n);
-  return st;
+  // Over every sample (the scene is grey).
+  return film_sample_stats(film);
 }
 
 struct GlassCase {
@@ -99,7 +81,7 @@ struct GlassCase {
 
 class GlassSlab : public ::testing::TestWithParam<GlassCase> {};
 
-void expect_mean(const Stats& s, double expected, const std::string& what) {
+void expect_mean(const SampleStats& s, double expected, const std::string& what) {
   // An exact answer (zero variance) still gets a float-rounding allowance.
   EXPECT_NEAR(s.mean, expected, 5 * s.se + 1e-5) << what << " (SE " << s.se << ")";
 }
@@ -129,7 +111,7 @@ INSTANTIATE_TEST_SUITE_P(
 // Index 1: the slab is invisible; every sample sees the emitter behind it, exactly.
 TEST(GlassSlabIndexOne, IsInvisible) {
   ClRuntime rt;
-  Stats s = render_glass(rt, 30, 1.0, false, true, false, "tree");
+  SampleStats s = render_glass(rt, 30, 1.0, false, true, false, "tree");
   EXPECT_NEAR(s.mean, 1.0, 1e-5);
   EXPECT_LT(s.se, 1e-6);
 }
@@ -143,8 +125,8 @@ TEST(RoughGlassSlab, MisAgreesWithBsdfSampling) {
   ClRuntime rt;
   for (int lights = 1; lights <= 3; ++lights) {
     bool behind = lights & 1, front = lights & 2;
-    Stats a = render_glass(rt, 40, 1.5, false, behind, front, "tree", 0.3, 1024);
-    Stats b = render_glass(rt, 40, 1.5, false, behind, front, "bsdf", 0.3, 1024);
+    SampleStats a = render_glass(rt, 40, 1.5, false, behind, front, "tree", 0.3, 1024);
+    SampleStats b = render_glass(rt, 40, 1.5, false, behind, front, "bsdf", 0.3, 1024);
     EXPECT_GT(a.mean, 0.05);
     EXPECT_NEAR(a.mean, b.mean, 5 * std::hypot(a.se, b.se))
         << "behind " << behind << " front " << front;

@@ -11,6 +11,7 @@
 #include "scene/pbrt_reader.h"
 #include "scene/scene.h"
 
+#include "support/film_stats.h"
 #include "support/pbrt_text.h"
 
 #include <gtest/gtest.h>
@@ -19,6 +20,7 @@
 #include <string>
 
 using namespace canopy;
+using namespace canopy::test;
 
 namespace {
 
@@ -36,11 +38,7 @@ std::string box(double x0, double y0, double z0, double x1, double y1, double z1
   return buf;
 }
 
-struct Stats {
-  double mean = 0, se = 0;
-};
-
-Stats render(const std::string& integrator, bool vacuum_inside) {
+SampleStats render(const std::string& integrator, bool vacuum_inside) {
   std::string text =
       "Integrator \"" + integrator + "\" \"integer maxdepth\" 64\n" +
       "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.1 0.1 0.1] "
@@ -69,16 +67,7 @@ Stats render(const std::string& integrator, bool vacuum_inside) {
   rs.seed = 5;
   Film film = renderer.render(rs);
   EXPECT_EQ(renderer.stats().nonfinite_samples, 0u);
-  double n = 0, s = 0, s2 = 0;
-  for (size_t p = 0; p < film.sum.size(); ++p) {
-    n += film.sum[p].w;
-    s += film.sum[p].y;
-    s2 += film.sumsq[p].y;
-  }
-  Stats st;
-  st.mean = s / n;
-  st.se = std::sqrt(std::max(0.0, s2 / n - st.mean * st.mean) / n);
-  return st;
+  return film_sample_stats(film);
 }
 
 double slab_transmittance() {
@@ -90,18 +79,18 @@ double slab_transmittance() {
 } // namespace
 
 TEST(PbrtMedia, GlassWithAVacuumInsideIsCrossedWithoutTheFog) {
-  Stats s = render("volpath", true);
+  SampleStats s = render("volpath", true);
   double expected = std::exp(-kSigmaA * 14) * slab_transmittance();
   EXPECT_NEAR(s.mean, expected, 5 * s.se + 1e-6) << "SE " << s.se;
 }
 
 TEST(PbrtMedia, GlassFilledWithTheFogAttenuatesInsideToo) {
-  Stats s = render("volpath", false);
+  SampleStats s = render("volpath", false);
   double expected = std::exp(-kSigmaA * 15) * slab_transmittance();
   EXPECT_NEAR(s.mean, expected, 5 * s.se + 1e-6) << "SE " << s.se;
 }
 
 TEST(PbrtMedia, PathIntegratorRendersNoMediaAsPbrt) {
-  Stats s = render("path", true);
+  SampleStats s = render("path", true);
   EXPECT_NEAR(s.mean, slab_transmittance(), 5 * s.se + 1e-6) << "SE " << s.se;
 }
