@@ -389,6 +389,26 @@ TEST(ScenePbrt, UnknownMaterialAndTextureFallBackWithWarnings) {
   }
 }
 
+// A spectrum file (pbrt-v4's (wavelength, value) pairs) as its values at 650, 550 and 450 nm:
+// the file's spectrum is 1 + (nm - 400) / 100.
+TEST(ScenePbrt, SpectrumFilesAreReadAtTheRgbWavelengths) {
+  Scene s = load(std::string(kKeptCamera) + "WorldBegin\n" +
+                 "Material \"conductor\" \"spectrum eta\" \"spds/linear.spd\" "
+                 "\"spectrum k\" \"spds/linear.spd\"\n" +
+                 tri_at("0 0 0  1 0 0  0 1 0"));
+  const Material& m = s.materials[size_t(s.triangle_material[0])].gpu;
+  EXPECT_FLOAT_EQ(m.specular.x, 3.5f);
+  EXPECT_FLOAT_EQ(m.specular.y, 2.5f);
+  EXPECT_FLOAT_EQ(m.specular.z, 1.5f);
+  EXPECT_FLOAT_EQ(m.k.x, 3.5f);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  std::string e = error_of(std::string(kKeptCamera) + "WorldBegin\n" +
+                           "Material \"conductor\" \"spectrum eta\" \"spds/odd.spd\"\n" +
+                           tri_at("0 0 0  1 0 0  0 1 0"));
+  EXPECT_EQ(e.rfind("t.pbrt:5: ", 0), 0u) << e;
+  EXPECT_NE(e.find("spds/odd.spd"), std::string::npos) << e;
+}
+
 TEST(ScenePbrt, DielectricsWithFloatOrNamedGlassIndex) {
   Scene s = load(
       std::string(kKeptCamera) + "WorldBegin\n" + "Material \"dielectric\" \"float eta\" 1.33\n" +

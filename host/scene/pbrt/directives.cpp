@@ -92,6 +92,7 @@ std::string Reader::one_string(const Token& d, Lexer& lx) {
 
 void Reader::directive(const Token& d, Lexer& lx, const std::filesystem::path& dir) {
   const std::string& k = d.text;
+  dir_ = dir;
   auto no_args = [&] {
     if (!lx.at_directive())
       fail(lx.peek()->loc, fmt::format("{}: unexpected {}", k, describe(*lx.peek())));

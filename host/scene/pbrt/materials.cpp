@@ -154,40 +154,43 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
       k = make_float3(kk(c.x), kk(c.y), kk(c.z));
     } else {
       // Named spectra "metal-<X>-eta"/"metal-<X>-k" (pbrt-v4 spectrum.cpp) map to Canopy's
-      // measured presets (metal_presets.cpp); copper is pbrt's default conductor.
-      auto preset_of = [&](const std::string& spec, const std::string& key,
-                           const char* which) -> const MetalPreset* {
+      // measured presets (metal_presets.cpp); another name is a spectrum file; copper is pbrt's
+      // default conductor.
+      auto named_value = [&](const std::string& spec, const std::string& key,
+                             bool is_eta) -> float3 {
         static const std::map<std::string, std::string> m = {
             {"Au", "gold"}, {"Ag", "silver"}, {"Cu", "copper"}, {"Al", "aluminium"}};
-        std::string pre = "metal-", suf = std::string("-") + which;
+        std::string pre = "metal-", suf = is_eta ? "-eta" : "-k";
+        const MetalPreset* pr = nullptr;
         if (spec.size() > pre.size() + suf.size() && spec.rfind(pre, 0) == 0 &&
             spec.compare(spec.size() - suf.size(), suf.size(), suf) == 0) {
           auto it = m.find(spec.substr(pre.size(), spec.size() - pre.size() - suf.size()));
-          if (it != m.end()) return find_metal_preset(it->second);
+          if (it != m.end()) pr = find_metal_preset(it->second);
         }
-        warn(p.find(key)->loc,
-             fmt::format("{}: spectrum \"{}\" has no Canopy preset (gold, silver, copper, "
-                         "aluminium): copper used, the spectrum ignored",
-                         p.what(), printable(spec)));
-        return find_metal_preset("copper");
+        if (!pr) {
+          const Loc& at = p.find(key)->loc;
+          if (auto v = spectrum_file(at, p.what(), spec)) return *v;
+          warn(at, fmt::format("{}: spectrum \"{}\" is no Canopy preset (gold, silver, copper, "
+                               "aluminium) and no file: copper used, the spectrum ignored",
+                               p.what(), printable(spec)));
+          pr = find_metal_preset("copper");
+        }
+        const float* c = is_eta ? pr->eta : pr->k;
+        return make_float3(c[0], c[1], c[2]);
       };
       const MetalPreset* cu = find_metal_preset("copper");
       eta = make_float3(cu->eta[0], cu->eta[1], cu->eta[2]);
       k = make_float3(cu->k[0], cu->k[1], cu->k[2]);
       std::string named;
-      if (auto e = p.spectrum(prefix + "eta", Params::Use::Reflectance, &named)) {
+      if (auto e = p.spectrum(prefix + "eta", Params::Use::Reflectance, &named))
         eta = *e;
-      } else if (!named.empty()) {
-        const MetalPreset* pr = preset_of(named, prefix + "eta", "eta");
-        eta = make_float3(pr->eta[0], pr->eta[1], pr->eta[2]);
-      }
+      else if (!named.empty())
+        eta = named_value(named, prefix + "eta", true);
       named.clear();
-      if (auto e = p.spectrum(prefix + "k", Params::Use::Reflectance, &named)) {
+      if (auto e = p.spectrum(prefix + "k", Params::Use::Reflectance, &named))
         k = *e;
-      } else if (!named.empty()) {
-        const MetalPreset* pr = preset_of(named, prefix + "k", "k");
-        k = make_float3(pr->k[0], pr->k[1], pr->k[2]);
-      }
+      else if (!named.empty())
+        k = named_value(named, prefix + "k", false);
       auto in = [](float3 c, float lo, float hi) {
         return c.x >= lo && c.y >= lo && c.z >= lo && c.x <= hi && c.y <= hi && c.z <= hi;
       };

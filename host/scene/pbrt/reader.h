@@ -26,6 +26,7 @@
 //   textures       Texture and the texture-valued parameters of materials
 //   materials      Material and MakeNamedMaterial
 //   media          MakeNamedMedium, MediumInterface and the camera's medium
+//   spectrum_file  spectra read from files of (wavelength, value) pairs
 //   load           the public entry points (scene/pbrt_reader.h)
 #pragma once
 
@@ -124,6 +125,9 @@ private:
   void area_light(const Token& d, Params& p, const std::string& type);
   int material(const Loc& loc, Params& p, const std::string& type, const std::string& name);
   float dielectric_eta(Params& p);
+  // A spectrum file named by a "spectrum" parameter, as RGB; nullopt if no such file exists.
+  std::optional<float3> spectrum_file(const Loc& loc, const std::string& what,
+                                      const std::string& name);
   void make_named_medium(const Token& d, Params& p, const std::string& name);
   void medium_interface(const Token& d, const std::vector<std::string>& names);
   int shape_material(const Loc& loc);
@@ -162,6 +166,7 @@ private:
   std::map<int, int> excluding_materials_; // material -> its copy that excludes the medium
   std::string camera_medium_;              // the outside medium at the Camera directive
   std::string integrator_ = "volpath";     // pbrt-v4's default
+  std::filesystem::path dir_;              // the directory of the file being read
   // Named textures: global (not scoped by attributes), one namespace per type (pbrt-v4
   // BasicSceneBuilder::Texture).
   std::map<std::string, NamedTexture> float_textures_, spectrum_textures_;
