@@ -189,7 +189,7 @@ TEST(SceneTexturesPbrt, RoughnessTexturesMapToAlpha) {
   EXPECT_EQ(a.alpha_texture, 1);
   EXPECT_EQ(a.albedo_texture, 0);
   EXPECT_EQ(b.alpha_texture, 2);
-  EXPECT_EQ(c.type, MATERIAL_PLASTIC);
+  EXPECT_EQ(c.type, MATERIAL_COATED_DIFFUSE);
   EXPECT_EQ(c.alpha_texture, 1);
   EXPECT_EQ(c.albedo_texture, 3);
   EXPECT_EQ(e.alpha_texture, 1);

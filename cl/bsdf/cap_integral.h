@@ -247,6 +247,10 @@ INLINE Material cap_coated_proxy(const Material* m) {
 }
 #endif
 
+// A material type test for cap_lobe_make: a coated material's stand-in is a conductor or a
+// plastic, so a kernel with coated materials but neither of those keeps their cap code.
+#define CAP_IS_MATERIAL(m, T) (HAS_##T || HAS_MATERIAL_COATED ? (m)->type == T : 0)
+
 INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
 #if HAS_MATERIAL_COATED
   Material proxy;
@@ -272,13 +276,13 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
   l.pad1 = 0.0f;
   int diffuse_base = 1;
 #if HAS_MICROFACET
-  int glossy_type = IS_MATERIAL(m, MATERIAL_CONDUCTOR) || IS_MATERIAL(m, MATERIAL_PLASTIC);
-  if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) diffuse_base = 0;
+  int glossy_type = CAP_IS_MATERIAL(m, MATERIAL_CONDUCTOR) || CAP_IS_MATERIAL(m, MATERIAL_PLASTIC);
+  if (CAP_IS_MATERIAL(m, MATERIAL_CONDUCTOR)) diffuse_base = 0;
   int glossy = glossy_type && !ggx_is_delta(m->alpha);
   // The glossy flag (cap_lobe_is_glossy) describes the material, also for a viewer below the
   // horizon, where the amplitudes stay 0.
   if (glossy)
-    l.wo.w = IS_MATERIAL(m, MATERIAL_PLASTIC) ? -ggx_alpha(m->alpha) : ggx_alpha(m->alpha);
+    l.wo.w = CAP_IS_MATERIAL(m, MATERIAL_PLASTIC) ? -ggx_alpha(m->alpha) : ggx_alpha(m->alpha);
 #endif
   if (!(cos_o > 0.0f)) return l; // bsdf_eval is 0 for a viewer below the horizon
 #if HAS_MICROFACET
@@ -306,7 +310,7 @@ INLINE CapLobe cap_lobe_make(const Material* m, const Frame* fr, float3 wo) {
     // from the normal, so F(cos theta_o) would overestimate it).
     float3 eta = xyz_of(m->specular), k = xyz_of(m->k);
     float f_lobe;
-    if (IS_MATERIAL(m, MATERIAL_CONDUCTOR)) {
+    if (CAP_IS_MATERIAL(m, MATERIAL_CONDUCTOR)) {
       float f1 = cap_mean3(fresnel_conductor(1.0f, eta, k));
       // Lazanyi's a: least squares over 8 cosines.
       float num = 0.0f, den = 0.0f;

@@ -213,6 +213,8 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
     // pbrt-v4's layered materials: a dielectric coat over a Lambertian or conductor base, with a
     // random walk between them (cl/bsdf/layered.h), with pbrt-v4's parameters and defaults.
     const bool conductor = type == "coatedconductor";
+    // (the reflectance first: its texture is registered before the roughness's, as for diffuse)
+    const float3 kd = conductor ? make_float3(0, 0, 0) : albedo("reflectance");
     float r = roughness(conductor ? "interface." : "");
     double eta = kDefaultPlasticIor;
     const std::string eta_key = conductor ? "interface.eta" : "eta";
@@ -257,7 +259,7 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
       conductor_index("conductor.", ceta, ck);
       md = coated_conductor_material(mname, r * r, float(eta), ceta, ck, rc * rc, layer);
     } else {
-      md = coated_diffuse_material(mname, albedo("reflectance"), r * r, float(eta), layer);
+      md = coated_diffuse_material(mname, kd, r * r, float(eta), layer);
     }
   } else if (type == "dielectric" || type == "thindielectric") {
     const bool thin = type == "thindielectric";
