@@ -10,6 +10,7 @@
 // - eval and pdf are 0 and there is no smooth lobe (light sampling skips glass);
 // - index 1 passes every sample straight on.
 #include "bsdf/bsdf.h"
+#include "support/direction_at.h"
 #include "support/fresnel_reference.h"
 #include "support/materials.h"
 
@@ -22,12 +23,6 @@ using namespace canopy;
 using namespace canopy::test;
 
 namespace {
-
-float3 wo_at(double theta_deg, double phi) {
-  double t = theta_deg * M_PI / 180;
-  return make_float3(float(std::sin(t) * std::cos(phi)), float(std::sin(t) * std::sin(phi)),
-                     float(std::cos(t)));
-}
 
 struct Counts {
   int reflected = 0, transmitted = 0;
@@ -90,7 +85,7 @@ TEST(BsdfDielectric, ReflectsWithFresnelAndRefractsBySnell) {
   for (double eta : {1.5, 1.0 / 1.5, 2.4, 1.0 / 2.4, 1.01})
     for (double theta : {0.0, 20.0, 40.0, 41.0, 42.5, 60.0, 80.0, 89.0}) {
       Material m = make_dielectric(float(eta));
-      float3 wo = wo_at(theta, 0.7 + theta);
+      float3 wo = direction_at(theta, 0.7 + theta);
       Counts c = sample_and_check(m, wo, n, seed++);
       double r = ref_fresnel(wo.z, eta);
       expect_share(c, r, "eta " + std::to_string(eta) + " theta " + std::to_string(theta));
@@ -105,7 +100,7 @@ TEST(BsdfDielectric, ThinSheetReflectsBothFacesAndPassesStraightOn) {
   uint32_t seed = 100;
   for (double theta : {0.0, 45.0, 75.0, 89.0}) {
     Material m = make_dielectric(1.5f, true);
-    float3 wo = wo_at(theta, 2.0);
+    float3 wo = direction_at(theta, 2.0);
     Counts c = sample_and_check(m, wo, n, seed++);
     double r = ref_fresnel(wo.z, 1.5);
     // R + T^2 R (1 + R^2 + R^4 + ...) with T = 1 - R: every path between the two faces.
@@ -116,7 +111,7 @@ TEST(BsdfDielectric, ThinSheetReflectsBothFacesAndPassesStraightOn) {
 TEST(BsdfDielectric, HasNoSmoothLobe) {
   for (Material m : {make_dielectric(1.5f), make_dielectric(1.5f, true)}) {
     EXPECT_EQ(bsdf_has_smooth_lobe(&m), 0);
-    float3 wo = wo_at(30, 0), wi = make_float3(-wo.x, -wo.y, wo.z);
+    float3 wo = direction_at(30, 0), wi = make_float3(-wo.x, -wo.y, wo.z);
     float3 f = bsdf_eval(&m, wo, wi);
     EXPECT_EQ(f.x + f.y + f.z, 0.0f);
     EXPECT_EQ(bsdf_pdf(&m, wo, wi), 0.0f);
@@ -126,7 +121,7 @@ TEST(BsdfDielectric, HasNoSmoothLobe) {
 TEST(BsdfDielectric, IndexOnePassesEverythingStraightOn) {
   Material m = make_dielectric(1.0f);
   for (double theta : {0.0, 30.0, 89.0}) {
-    float3 wo = wo_at(theta, 1.0);
+    float3 wo = direction_at(theta, 1.0);
     Counts c = sample_and_check(m, wo, 1000, 7);
     EXPECT_EQ(c.reflected, 0);
   }

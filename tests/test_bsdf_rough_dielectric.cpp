@@ -11,6 +11,7 @@
 //   refracted directions obey Snell's law;
 // - there is a smooth lobe, and eval, pdf and sample stay finite at grazing angles.
 #include "bsdf/bsdf.h"
+#include "support/direction_at.h"
 #include "support/fresnel_reference.h"
 #include "support/materials.h"
 
@@ -24,12 +25,6 @@ using namespace canopy;
 using namespace canopy::test;
 
 namespace {
-
-float3 dir_at(double theta_deg, double phi) {
-  double t = theta_deg * M_PI / 180;
-  return make_float3(float(std::sin(t) * std::cos(phi)), float(std::sin(t) * std::sin(phi)),
-                     float(std::cos(t)));
-}
 
 float3 dir_mu(double mu, double phi) {
   double s = std::sqrt(std::max(0.0, 1 - mu * mu));
@@ -61,7 +56,7 @@ class RoughDielectric : public ::testing::TestWithParam<Case> {};
 TEST_P(RoughDielectric, AlbedoAndPdfMatchQuadrature) {
   const Case c = GetParam();
   Material m = make_dielectric(c.eta, false, c.alpha);
-  const float3 wo = dir_at(c.theta, 0.4);
+  const float3 wo = direction_at(c.theta, 0.4);
   const int nb = 16;
   // Quadrature: fine enough for these lobes (alpha >= 0.2) to ~1e-3 relative.
   std::vector<double> pdf_bands =
@@ -161,7 +156,7 @@ TEST(RoughDielectricLimit, NearSmoothIsFresnelAndSnell) {
     for (float eta : {1.5f, 1 / 1.5f})
       for (double theta : {0.0, 30.0, 60.0, 85.0}) {
         Material m = make_dielectric(eta, false, alpha);
-        float3 wo = dir_at(theta, 1.1);
+        float3 wo = direction_at(theta, 1.1);
         std::mt19937 rng(11);
         std::uniform_real_distribution<float> uni(0.0f, 1.0f);
         const int n = 100000;
@@ -203,7 +198,7 @@ TEST(RoughDielectricEdges, SmoothLobeAndFiniteEverywhere) {
     for (float eta : {1.5f, 1 / 1.5f, 1.0001f}) {
       Material m = make_dielectric(eta, false, alpha);
       for (double theta : {0.0, 45.0, 89.9, 89.999, 90.0}) {
-        float3 wo = dir_at(theta, 0.7);
+        float3 wo = direction_at(theta, 0.7);
         for (int i = 0; i < 2000; ++i) {
           BsdfSample s = bsdf_sample(&m, wo, make_float3(uni(rng), uni(rng), uni(rng)));
           ASSERT_TRUE(std::isfinite(s.weight.x) && std::isfinite(s.pdf) && s.pdf >= 0);

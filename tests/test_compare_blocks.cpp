@@ -1,6 +1,7 @@
 // Block-mean agreement (image/block_agreement.h) on images whose block means are known by
 // construction: a uniform scale, one changed block, dark blocks left out, partial edge blocks.
 #include "image/block_agreement.h"
+#include "support/constant_image.h"
 
 #include <gtest/gtest.h>
 
@@ -8,16 +9,9 @@
 #include <stdexcept>
 
 using namespace canopy;
+using namespace canopy::test;
 
 namespace {
-
-RgbImage constant_image(int w, int h, float v) {
-  RgbImage img;
-  img.width = w;
-  img.height = h;
-  img.rgb.assign(size_t(w) * size_t(h) * 3, v);
-  return img;
-}
 
 void fill_block(RgbImage& img, int x0, int y0, int n, float v) {
   for (int y = y0; y < std::min(img.height, y0 + n); ++y)

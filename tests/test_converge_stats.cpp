@@ -2,6 +2,7 @@
 // the top-0.1% share, the reference floor MSE(A, B) / 4 and masked MSE. Synthetic data, fixed
 // seeds.
 #include "image/error_stats.h"
+#include "support/constant_image.h"
 
 #include <gtest/gtest.h>
 
@@ -9,18 +10,9 @@
 #include <random>
 
 using namespace canopy;
+using namespace canopy::test;
 
-namespace {
-
-RgbImage constant_image(int w, int h, float v) {
-  RgbImage img;
-  img.width = w;
-  img.height = h;
-  img.rgb.assign(size_t(w) * size_t(h) * 3, v);
-  return img;
-}
-
-} // namespace
+namespace {} // namespace
 
 // Over many independent synthetic experiments of 8 "seeds" each (exponential MSEs, heavy-ish
 // tailed as per-seed MSEs are), the 95% percentile interval of the mean covers the true mean in
