@@ -11,6 +11,7 @@
 #include "render/device_scene.h"
 #include "render/features.h"
 #include "render/light_sampler_data.h"
+#include "row_bands.h"
 #include "scene/scene.h"
 
 #include <cstdint>
@@ -100,6 +101,15 @@ struct Film {
   std::vector<uint8_t> emitter_mask() const;
 };
 
+// Bands of a window's rows that a render covers (cl/row_bands.h): bands of `height` rows repeat
+// every `period` bands, and the render covers those whose number mod period is in [first, first +
+// count). The film's other rows get no samples. Every row by default.
+struct RowBands {
+  int height = 1, period = 1, first = 0, count = 1;
+  bool all() const { return first == 0 && count >= period; }
+  int4 packed() const { return make_int4(height, period, first, count); }
+};
+
 struct RenderSettings {
   int spp = 1;
   uint32_t seed = 1;
@@ -109,6 +119,7 @@ struct RenderSettings {
   // (`canopy merge`). first_sample + spp <= kMaxSpp.
   int first_sample = 0;
   PixelWindow window;
+  RowBands bands;                     // of the window's rows
   size_t wave_size = size_t(1) << 18; // paths per wave (smaller when splitting: see render())
   std::function<void(double fraction)> progress; // optional, called after each wave
 };
