@@ -121,10 +121,15 @@ NamedTexture Reader::operator_texture(const Loc& loc, Params& p, const std::stri
     NamedTexture a = texture_input(p, "tex", is_float, one),
                  b = texture_input(p, "scale", true, one);
     if (a.kind == K::Unsupported || b.kind == K::Unsupported) return t; // warned where defined
-    if (b.kind == K::Constant) return scaled_texture(loc, a, b.value.x, is_float);
-    if (a.kind == K::Constant && a.value.x == 1.0f && a.value.y == 1.0f && a.value.z == 1.0f &&
-        is_float)
-      return b;
+    // An image (or any texture) times a constant: the constant folds into it (an image's scale).
+    auto fold = [&](const NamedTexture& x, float k) {
+      NamedTexture r = scaled_texture(loc, x, k, is_float);
+      if (r.kind == K::Image && r.tree.empty())
+        r.desc.where = fmt::format("{}:{}: texture \"{}\"", *loc.file, loc.line, printable(name));
+      return r;
+    };
+    if (b.kind == K::Constant) return fold(a, b.value.x);
+    if (a.kind == K::Constant && is_float) return fold(b, a.value.x); // float: both are scalars
     return compose(TEXTURE_SCALE, {{&a, is_float}, {&b, true}});
   }
   if (cls == "mix") {
@@ -175,7 +180,6 @@ NamedTexture Reader::operator_texture(const Loc& loc, Params& p, const std::stri
   for (double x : uvm)
     if (!std::isfinite(float(x)))
       fail(loc, fmt::format("{}: uscale, vscale, udelta, vdelta: a value is too large", p.what()));
-  (void)name;
   return compose(TEXTURE_CHECKERBOARD, {{&a, is_float}, {&b, is_float}},
                  make_float4(float(uvm[0]), float(uvm[1]), float(uvm[2]), float(uvm[3])));
 }
