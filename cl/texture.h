@@ -82,7 +82,9 @@ INLINE float3 texture_eval(GLOBAL const Texture* textures, GLOBAL const float* t
                            float2 uv) {
   float3 stack[TEXTURE_STACK];
   int top = 0;
-  for (int i = root - textures[root].nodes + 1; i <= root; ++i) {
+  // (a zero-initialised record, nodes 0, is an image alone)
+  const int first = root - max(textures[root].nodes, 1) + 1;
+  for (int i = first; i <= root; ++i) {
     GLOBAL const Texture* t = &textures[i];
     float3 v;
     if (t->kind == TEXTURE_IMAGE) {
