@@ -116,6 +116,10 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
                                                           h.prim, h.u, h.v)
                                    : prim->material;
   Material m = sc->materials[mat];
+  // Whether the surface bounds a medium-free inside belongs to the surface (its own material),
+  // not to the material a mix chose.
+  if (HAS_MATERIAL_MIX ? mat != prim->material : 0)
+    m.excludes_medium = sc->materials[prim->material].excludes_medium;
   material_face(&m, dot(Ng, d) > 0.0f); // a ray from inside glass sees the inverse index
   if (HAS_TEXTURES ? (m.albedo_texture | m.alpha_texture | m.transmittance_texture) != 0 : 0) {
     // The textured albedo, alpha and transmittance at the hit, kept for light_pick and brdf_mis
