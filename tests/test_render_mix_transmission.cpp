@@ -9,8 +9,9 @@
 //   R / pi closed forms on the camera's side, for every light sampler (the light tree's bound must
 //   see the light behind the plate), and MIS with BSDF rays through the plate (an area light
 //   behind it) agrees with BSDF sampling alone;
-// - kernels of scenes without these features hold none of their code, and the minimal kernels
-//   render the same images as kernels with every feature.
+// - kernels of scenes without these features hold none of their code (their programs are smaller
+//   than the same programs with it), and the minimal kernels render the same images as kernels
+//   with every feature.
 #include "render/camera.h"
 #include "render/features.h"
 #include "render/renderer.h"
@@ -275,6 +276,24 @@ TEST(RenderMix, KernelsHoldTheseFeaturesOnlyWhereTheSceneUsesThem) {
                                                           make_float3(0.5f, 0.5f, 0.5f)));
   mixed.lights.push_back(point_light(make_float3(0.3f, 0.2f, -1.0f), make_float3(3, 3, 3)));
   mixed.lights.push_back(point_light(make_float3(-0.3f, 0.2f, 1.0f), make_float3(2, 2, 2)));
+  // The code is gone, not just unused: the program of the plain scene's features is smaller than
+  // the same program with the mix or the diffuse-transmission code.
+  {
+    ClRuntime rt;
+    auto binary_size = [&](const KernelFeatures& k) {
+      cl::Program p = rt.build_program(wavefront_kernel_files(), k.build_options());
+      size_t total = 0;
+      for (size_t n : p.getInfo<CL_PROGRAM_BINARY_SIZES>())
+        total += n;
+      return total;
+    };
+    KernelFeatures with_mix = f, with_dt = f;
+    with_mix.material_mix = true;
+    with_dt.material_diffuse_transmission = true;
+    const size_t plain_size = binary_size(f);
+    EXPECT_LT(plain_size, binary_size(with_mix));
+    EXPECT_LT(plain_size, binary_size(with_dt));
+  }
   KernelFeatures g = scene_features(mixed, SAMPLER_TREE_SPLIT);
   EXPECT_TRUE(g.material_mix);
   EXPECT_TRUE(g.material_diffuse_transmission);
