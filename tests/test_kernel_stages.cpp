@@ -190,6 +190,8 @@ protected:
       p.shade_wo.push_back(make_float4(0, 0, 0, 0));
       p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
       p.shade_tex.push_back(make_float4(0, 0, 0, 0));
+      p.shade_tex_t.push_back(make_float4(0, 0, 0, 0));
+      p.shade_back.push_back(make_float4(0, 0, 0, 0)); // previous vertices one-sided
       p.brdf_state.push_back(make_int4(0, 0, 0, 0));
       p.brdf_share.push_back(0.0f);
       p.seg_o.push_back(make_float4(0, 0, 0, -1));

@@ -67,7 +67,7 @@ struct alignas(16) double2 {
   double x, y;
 };
 static_assert(sizeof(double4) == 32 && sizeof(double2) == 16);
-static_assert(sizeof(Material) == 112 && sizeof(Light) == 96 && sizeof(Primitive) == 64 &&
+static_assert(sizeof(Material) == 128 && sizeof(Light) == 96 && sizeof(Primitive) == 64 &&
               sizeof(Texture) == 64 && sizeof(float2) == 8 && sizeof(Medium) == 64);
 
 // A window [x0, x1) x [y0, y1) of the film's pixels; empty: the whole film.
