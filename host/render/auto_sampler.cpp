@@ -284,13 +284,30 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     wave_passes.push_back(int(std::clamp(std::ceil(wave / npix), 1.0, 256.0)));
   }
   int renders = 0;
-  const std::vector<int> passes = settings.window.empty()
-                                      ? plan_exploration(settings.spp, wave_passes, &renders)
-                                      : std::vector<int>();
+  std::vector<int> passes = settings.window.empty()
+                                ? plan_exploration(settings.spp, wave_passes, &renders)
+                                : std::vector<int>();
+  // Too few samples for every candidate to render two in each pixel: each renders two on its
+  // own interleaved rows (every n-th row), the chosen one the rest of every pixel.
+  const int n = int(cand.size());
+  const bool interleaved =
+      passes.empty() && settings.window.empty() && settings.spp >= kInterleavedMinSpp && fh >= n;
+  if (interleaved) {
+    passes.assign(cand.size(), 1);
+    renders = 1;
+    for (int i = 0; i < n; ++i) {
+      cand[size_t(i)].bands = RowBands{1, n, i, 1};
+      cand[size_t(i)].explored_share =
+          double(covered_rows(cand[size_t(i)].bands.packed(), fh)) / double(fh);
+    }
+  }
   RenderSettings rs = settings;
   rs.progress = nullptr;
-  if (passes.empty()) { // no room to explore: the last candidate, as a partial render takes
-    choice.chosen = cand.back();
+  if (passes.empty()) {
+    // No room to explore. A window is a partial render: the last candidate, as `canopy render
+    // --crop` takes, so that partial renders merge. 1 or 2 spp: the cheap `tree`; a preview that
+    // short cannot afford the costly candidate's samples (3 s for one on glossy-cornell).
+    choice.chosen = settings.window.empty() ? cand[kFewSamplesCandidate] : cand.back();
     choice.reason = "too few samples to explore";
     if (!same_sampler(renderer.options(), choice.chosen.options))
       renderer.set_light_sampler(choice.chosen.options);
@@ -308,6 +325,7 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     PilotResult& c = cand[i];
     if (!same_sampler(renderer.options(), c.options)) renderer.set_light_sampler(c.options);
     rs.bands = c.bands;
+    if (interleaved) next = settings.first_sample; // the same indices, on other rows
     c.first_sample = next;
     rs.first_sample = next;
     rs.spp = 1;
@@ -367,7 +385,7 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   rs.spp = settings.first_sample + settings.spp - next;
   Film rest = renderer.render(rs);
   for (const PilotResult& c : cand) {
-    if (c.bands.all()) continue;
+    if (c.bands.all() || interleaved) continue; // interleaved: the candidates cover every row
     rs.first_sample = c.first_sample;
     rs.spp = c.samples;
     rs.bands = c.bands;

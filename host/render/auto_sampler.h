@@ -76,9 +76,10 @@ struct AutoRender {
 
 // The candidates for `base` (whose light sampler is ignored): power, tree, and brdf-mis with
 // splitting at the renderer's default threshold (it renders as tree-split on a scene without a
-// glossy material); each keeps base's other settings. The last is the one taken without
-// exploration.
+// glossy material); each keeps base's other settings. The last is the one a partial render
+// (`--samples`, `--crop`) takes without exploring; kFewSamplesCandidate renders 1 or 2 spp.
 std::vector<PilotResult> auto_candidates(const RendererOptions& base);
+constexpr size_t kFewSamplesCandidate = 1; // tree
 
 // How many passes each candidate's two timed exploration renders hold, for a render of `spp`
 // samples per pixel: `wave_passes` (one per candidate) fills one of its waves. A candidate renders
@@ -116,6 +117,10 @@ std::vector<double> exploration_weights(std::vector<PilotResult> other);
 // that does not weighs the per-wave costs more than the render does). `period` <= 0: the most of
 // 1 to 4 that keeps that many pixels and a band in every tile of the film's 8 x 8.
 constexpr int kExploreBandRows = 8;
+// Below the room for two samples per candidate in every pixel (plan_exploration), down to this
+// many samples per pixel, each candidate renders two samples on its own interleaved rows (every
+// third row: the rows of all candidates show the same image) and the chosen one the rest.
+constexpr int kInterleavedMinSpp = 3;
 constexpr int kExploredPixels = 16384;
 RowBands exploration_bands(int width, int height, int period = 0);
 
@@ -123,7 +128,9 @@ RowBands exploration_bands(int width, int height, int period = 0);
 // candidate after exploring all, some on bands of rows (exploration_bands(film, explore_period);
 // see the file comment); the film's sums are weighted so that its mean is the
 // unbiased image and its count per pixel is spp. Leaves `renderer` set to the chosen candidate.
-// Without room to explore (plan_exploration), the last candidate renders it all.
+// With too few samples to explore on every pixel (plan_exploration), down to kInterleavedMinSpp,
+// the candidates explore on interleaved rows; below that kFewSamplesCandidate renders it all, and
+// in a window the last candidate.
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
                        const RenderSettings& settings, int explore_period = 0);
 
