@@ -5,7 +5,8 @@ seeds, with 95% bootstrap intervals; over all pixels and over the pixels without
 view. The clock a user waits on, beside the render-only efficiency of `canopy converge`.
 
   scripts/whole-process-efficiency.py SCENE --configs auto,power,tree,brdf-mis:0.25 \\
-      --spp 16,64 --seeds 8 --reference REF.exr [--canopy build/canopy] [--work DIR]
+      --spp 16,64 --seeds 8 --reference REF.exr [--film-scale S] [--canopy build/canopy] \\
+      [--work DIR]
 
 A configuration is a --light-sampler name with an optional :T split threshold. Without REF.exr
 the reference is made: two halves of --reference-spp samples (tree-split at 0.5, other seeds'
@@ -37,6 +38,10 @@ def compare(canopy, test, ref, mask):
     return j["pixel_mse"], j["pixel_mse_unmasked"]
 
 
+def render_cmd(a):
+    return [a.canopy, "render", a.scene, "--film-scale", str(a.film_scale)]
+
+
 def render_args(config):
     name, _, threshold = config.partition(":")
     args = ["--light-sampler", name]
@@ -51,7 +56,7 @@ def make_reference(a, ref):
     parts = []
     for h in range(2):
         part = os.path.join(a.work, f"ref-half{h}.exr")
-        cmd = [a.canopy, "render", a.scene, "--light-sampler", "tree-split", "--split-threshold",
+        cmd = render_cmd(a) + ["--light-sampler", "tree-split", "--split-threshold",
                "0.5", "--samples", f"{h * half}:{(h + 1) * half}", "--seed", "4242", "--out", part,
                "--png", part[:-4] + ".png", "--quiet"]
         if h == 0:
@@ -86,6 +91,7 @@ def main():
     ap.add_argument("--reference-spp", type=int, default=1024)
     ap.add_argument("--canopy", default="build/canopy")
     ap.add_argument("--work", default="out/whole-process")
+    ap.add_argument("--film-scale", type=float, default=1.0)
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     ref = a.reference
@@ -100,7 +106,7 @@ def main():
     # on a user's second render (the first on a fresh machine is measured apart).
     for c in configs:
         out = os.path.join(a.work, "warm-up")
-        run([a.canopy, "render", a.scene, "--spp", "8", "--out", out + ".exr", "--quiet"] +
+        run(render_cmd(a) + ["--spp", "8", "--out", out + ".exr", "--quiet"] +
             render_args(c))
     for spp in spps:
         res = {c: {"mse": [], "clear": [], "secs": [], "chosen": []} for c in configs}
@@ -108,7 +114,7 @@ def main():
             for c in configs:
                 out = os.path.join(a.work, f"{c.replace('/', '_').replace(':', '_')}-{spp}-{seed}")
                 stats = out + ".json"
-                cmd = [a.canopy, "render", a.scene, "--spp", str(spp), "--seed", str(seed),
+                cmd = render_cmd(a) + ["--spp", str(spp), "--seed", str(seed),
                        "--out", out + ".exr", "--png", out + ".png", "--quiet", "--stats-json",
                        stats] + render_args(c)
                 t0 = time.monotonic()
