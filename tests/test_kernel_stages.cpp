@@ -22,6 +22,7 @@
 #include "render/light_sampler_data.h"
 #include "render/renderer.h"
 #include "rng.h"
+#include "sampler.h"
 
 #include "support/glossy_points.h"
 
@@ -179,7 +180,13 @@ protected:
       p.hits.push_back(h);
       p.throughput.push_back(make_float4(0.2f + u(rng), 0.2f + u(rng), 0.2f + u(rng), 0));
       p.radiance.push_back(make_float4(u(rng), u(rng), u(rng), 0));
-      p.rng.push_back(uint32_t(rng()));
+      // Every third path draws from the Sobol sampler (key, sample index; shade_surface and
+      // shade_volume set the vertex's dimensions), the others from their PCG state.
+      if (i % 3 == 1)
+        p.rng.push_back(
+            make_uint4(uint32_t(rng()), uint32_t(rng() % 4096), 0u, PATH_SAMPLER_SOBOL));
+      else
+        p.rng.push_back(make_uint4(uint32_t(rng()), 0u, 0u, PATH_SAMPLER_INDEPENDENT));
       // Previous vertex: a point in the room, a normal, and the pdf of the BSDF ray (0: none).
       float3 sp = make_float3(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng)) - origin_;
       p.shade_P.push_back(f4_from3(sp, i % 3 == 0 ? 0.0f : u(rng)));
@@ -691,7 +698,7 @@ protected:
                                  KernelFeatures::all(SAMPLER_UNIFORM).build_options());
   }
   void check_accumulate(int npix, int wave, uint64_t base);
-  void check_generate(int4 window, uint32_t first_pass);
+  void check_generate(int4 window, uint32_t first_pass, uint32_t path_sampler);
   ClRuntime rt_;
   cl::Program program_;
 };
@@ -701,11 +708,13 @@ protected:
 TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
   for (int4 window : {make_int4(0, 0, 37, 23), make_int4(5, 3, 11, 7)}) {
     const uint32_t first_pass = window.z == 37 ? 0 : 17;
-    check_generate(window, first_pass);
+    check_generate(window, first_pass, PATH_SAMPLER_INDEPENDENT);
+    check_generate(window, first_pass, PATH_SAMPLER_SOBOL);
   }
 }
 
-void KernelUtilities::check_generate(int4 window, uint32_t first_pass) {
+void KernelUtilities::check_generate(int4 window, uint32_t first_pass, uint32_t path_sampler) {
+  SCOPED_TRACE(::testing::Message() << "path sampler " << path_sampler);
   Camera cam;
   cam.position = make_float3(1, 2, 3);
   cam.look_at = make_float3(0, 0.5f, -1);
@@ -716,20 +725,21 @@ void KernelUtilities::check_generate(int4 window, uint32_t first_pass) {
   KernelArgs args;
   args.set("cam", to_device(rt_, cp));
   args.set("seed", cl_uint(99));
+  args.set("path_sampler", cl_uint(path_sampler));
   args.set("window", window);
   args.set("first_pass", cl_uint(first_pass));
   args.set("wave_base", cl_ulong(base));
   args.set("count", cl_int(n));
   for (const char* name : {"ray_o", "ray_d", "throughput", "radiance"})
     args.set(name, cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(float4)));
-  args.set("rng", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(uint32_t)));
+  args.set("rng", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(uint4)));
   args.set("ray_queue", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int)));
   args.set("path_counts", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int4)));
   BoundKernel k(program_, "generate", args);
   enqueue_1d(rt_.queue(), k.bind(), n);
   auto o = from_device<float4>(rt_, args.buffer("ray_o"), n);
   auto d = from_device<float4>(rt_, args.buffer("ray_d"), n);
-  auto rng = from_device<uint32_t>(rt_, args.buffer("rng"), n);
+  auto rng = from_device<uint4>(rt_, args.buffer("rng"), n);
   auto queue = from_device<int>(rt_, args.buffer("ray_queue"), n);
   // Independent reference: the pixel's jittered point on the image plane, from the camera basis.
   float3 fwd = normalize(cam.look_at - cam.position), right = normalize(cross(fwd, cam.up));
@@ -741,15 +751,21 @@ void KernelUtilities::check_generate(int4 window, uint32_t first_pass) {
     uint32_t in_win = uint32_t(g % nwin), pass = first_pass + uint32_t(g / nwin);
     uint32_t pixel =
         uint32_t((window.y + int(in_win) / window.z) * w + window.x + int(in_win) % window.z);
-    PathRng r = rng_seed(99, pixel, pass);
-    float jx = rng_next_float(&r), jy = rng_next_float(&r);
-    float sx = (float(pixel % w) + jx) / float(w), sy = (float(pixel / w) + jy) / float(h);
+    float2 j;
+    uint4 state = path_sampler_start(path_sampler, 99, pixel, pass, &j);
+    if (path_sampler == PATH_SAMPLER_INDEPENDENT) { // the PCG stream's first two numbers
+      PathRng r = rng_seed(99, pixel, pass);
+      ASSERT_EQ(j.x, rng_next_float(&r));
+      ASSERT_EQ(j.y, rng_next_float(&r));
+      ASSERT_EQ(state.x, r.state);
+    }
+    float sx = (float(pixel % w) + j.x) / float(w), sy = (float(pixel / w) + j.y) / float(h);
     float3 dir = normalize(fwd + right * ((2 * sx - 1) * tw) + up * ((1 - 2 * sy) * th));
     ASSERT_NEAR(d[size_t(i)].x, dir.x, 1e-5f) << i;
     ASSERT_NEAR(d[size_t(i)].y, dir.y, 1e-5f) << i;
     ASSERT_NEAR(d[size_t(i)].z, dir.z, 1e-5f) << i;
     ASSERT_EQ(o[size_t(i)].x, 1.0f);
-    ASSERT_EQ(rng[size_t(i)], r.state) << i;
+    ASSERT_EQ(rng[size_t(i)], state) << i;
     ASSERT_EQ(queue[size_t(i)], i);
   }
 }

@@ -20,7 +20,7 @@
 #include "../bsdf/bsdf.h"
 #include "../geometry.h"
 #include "../lights/light_sample.h"
-#include "../rng.h"
+#include "../sampler.h"
 #include "../shading.h"
 #include "../texture.h"
 #include "brdf_mis.h"
@@ -33,7 +33,7 @@ INLINE float shade_emission_weight(const LightSamplerCtx* ls, const SceneBuffers
                                    const PathBuffers* pb, int path, int depth, int light,
                                    float3 P) {
   float4 prev_P = pb->shade_P[path];
-  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
+  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == PATH_DIM_BSDF) return 1.0f;
   // A medium vertex: the phase technique against the segment's light samples (volume_light.h).
   if (HAS_MEDIUM && pb->shade_f[path].w == VOLUME_POINT_FLAG)
     return CANOPY_MIS ? volume_emission_weight(ls, sc, pb, path, light, P) : 0.0f;
@@ -52,7 +52,7 @@ INLINE float shade_emission_weight(const LightSamplerCtx* ls, const SceneBuffers
 INLINE float shade_environment_weight(const LightSamplerCtx* ls, const PathBuffers* pb, int path,
                                       int depth, const GLOBAL Light* l, float3 d) {
   float4 prev_P = pb->shade_P[path];
-  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
+  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == PATH_DIM_BSDF) return 1.0f;
   if (!CANOPY_MIS) return 0.0f; // light sampling alone accounts for it
   return power_heuristic(prev_P.w, env_pdf(l, &ls->env, light_query_normal(pb, path), d));
 }
@@ -107,8 +107,6 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
     return out;
   }
 
-  PathRng r;
-  r.state = pb->rng[path];
   Material m = sc->materials[prim->material];
   material_face(&m, dot(Ng, d) > 0.0f); // a ray from inside glass sees the inverse index
   if (HAS_TEXTURES ? (m.albedo_texture | m.alpha_texture) != 0 : 0) {
@@ -117,17 +115,35 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
     material_apply_textures(&m, sc->texcoords, sc->textures, sc->texels, h.prim, h.u, h.v);
     pb->shade_tex[path] = f4_from3(xyz_of(m.albedo), m.alpha);
   }
-  uint light_seed = rng_next_u32(&r);
-  float u1 = rng_next_float(&r);
-  float u2 = rng_next_float(&r);
-  float u_rr = rng_next_float(&r);
-  float u3 = rng_next_float(&r);
-  pb->rng[path] = r.state;
+  // The vertex's numbers (cl/sampler.h): the light samplers' seed, the BSDF direction, Russian
+  // roulette, the lobe choice.
+  uint4 ps = pb->rng[path];
+  uint light_seed;
+  float u1, u2, u_rr, u3;
+  if (ps.w == PATH_SAMPLER_SOBOL) {
+    ps.z = sampler_vertex_base(depth); // light_pick reads this vertex's dimensions too
+    light_seed = path_sampler_hash(ps, PATH_DIM_LIGHT_SEED);
+    float2 ub = path_sampler_2d(ps, PATH_DIM_BSDF);
+    u1 = ub.x;
+    u2 = ub.y;
+    u_rr = path_sampler_1d(ps, PATH_DIM_RR);
+    u3 = path_sampler_1d(ps, PATH_DIM_LOBE);
+  } else {
+    PathRng r;
+    r.state = ps.x;
+    light_seed = rng_next_u32(&r);
+    u1 = rng_next_float(&r);
+    u2 = rng_next_float(&r);
+    u_rr = rng_next_float(&r);
+    u3 = rng_next_float(&r);
+    ps.x = r.state;
+  }
+  pb->rng[path] = ps;
 
   int last = depth + 1 >= max_depth; // the BSDF ray only looks for emission (see the top)
   // Light shapes are black diffuse: nothing to pick lights for.
   int black = m.type == MATERIAL_DIFFUSE && !(max3(xyz_of(m.albedo)) > 0.0f);
-  out.y = (ls->light_count > 0 || ls->infinite_count > 0) && ls->kind != SAMPLER_BSDF &&
+  out.y = (ls->light_count > 0 || ls->infinite_count > 0) && ls->kind != PATH_DIM_BSDF &&
           bsdf_has_smooth_lobe(&m) && !black;
   float mis_flag = CANOPY_MIS ? 1.0f : 0.0f;
   if (HAS_MICROFACET && light_sampler_brdf(ls)) {
@@ -155,7 +171,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   // From the last vertex, only a ray whose emission gets a weight (shade_emission_weight).
   // (An environment light gives an escaped ray a weight at glossy points of the BRDF samplers too.)
   int env_weighs = CANOPY_MIS ? light_sampler_has_environment(ls) : 0;
-  if (last && !bs.is_delta && ls->kind != SAMPLER_BSDF && !(mis_flag == 1.0f) && !env_weighs)
+  if (last && !bs.is_delta && ls->kind != PATH_DIM_BSDF && !(mis_flag == 1.0f) && !env_weighs)
     return out;
   float3 wi = frame_to_world(&fr, bs.wi);
   // A direction to the other side of the geometric surface than the lobe's would leak light
