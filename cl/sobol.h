@@ -30,16 +30,19 @@ INLINE uint sobol_dim0(uint i) {
   return sobol_reverse_bits(i);
 }
 
-// Sample i of Sobol dimension 1 as a 32-bit fraction: the XOR of the direction numbers of i's set
-// bits (a fixed 32-step loop without data-dependent branches, so kernels stay vectorisable).
+// Sample i of Sobol dimension 1 as a 32-bit fraction. Its generator matrix is Pascal's triangle
+// mod 2: bit c of i flips the fraction's bit r (weight 2^-(r+1)) iff the bits of r are a subset of
+// those of c (Lucas' theorem; the direction numbers v_c = v_(c-1) ^ (v_(c-1) >> 1)). So bit r of
+// the bit-reversed result is the XOR of i's bits c over the supersets c of r: a superset transform
+// in five masked shifts, without loops or branches.
 INLINE uint sobol_dim1(uint i) {
-  uint x = 0u;
-  uint v = 0x80000000u;
-  for (int b = 0; b < 32; ++b) {
-    x ^= (0u - ((i >> b) & 1u)) & v;
-    v ^= v >> 1;
-  }
-  return x;
+  uint y = i;
+  y ^= (y >> 1) & 0x55555555u;
+  y ^= (y >> 2) & 0x33333333u;
+  y ^= (y >> 4) & 0x0f0f0f0fu;
+  y ^= (y >> 8) & 0x00ff00ffu;
+  y ^= (y >> 16) & 0x0000ffffu;
+  return sobol_reverse_bits(y);
 }
 
 // Owen scramble of a 32-bit fraction v (bit 31 is 1/2) with a 32-bit seed.

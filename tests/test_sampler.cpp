@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 namespace {
@@ -64,11 +65,21 @@ TEST(SobolPoints, UnscrambledSequenceIsANet) {
     }
     EXPECT_TRUE(is_net(x, y, k)) << "k = " << k;
   }
-  // The second dimension is Sobol's: 0, 1/2, 3/4, 1/4, 3/8, 7/8, 5/8, 1/8.
+  // The second dimension is Sobol's (in index order, not Gray-code order): 0, 1/2, 3/4, 1/4, 5/8,
+  // 1/8, 3/8, 7/8.
   const uint32_t first[8] = {0u,          0x80000000u, 0xc0000000u, 0x40000000u,
-                             0x60000000u, 0xe0000000u, 0xa0000000u, 0x20000000u};
+                             0xa0000000u, 0x20000000u, 0x60000000u, 0xe0000000u};
   for (uint32_t i = 0; i < 8; ++i)
     EXPECT_EQ(sobol_dim1(i), first[i]) << i;
+  // The closed form is the XOR of the direction numbers of the index's bits.
+  std::mt19937 rng(5);
+  for (int t = 0; t < 100000; ++t) {
+    const uint32_t i = t < 4096 ? uint32_t(t) : uint32_t(rng());
+    uint32_t x = 0u, v = 0x80000000u;
+    for (int b = 0; b < 32; ++b, v ^= v >> 1)
+      if ((i >> b) & 1u) x ^= v;
+    ASSERT_EQ(sobol_dim1(i), x) << i;
+  }
   // A pair of van der Corput coordinates is not a net: the check can fail.
   std::vector<uint32_t> x, y;
   for (uint32_t i = 0; i < 16; ++i) {

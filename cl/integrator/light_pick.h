@@ -122,7 +122,6 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
   // shared by choices whose number depends on the cut); medium segments keep theirs entirely.
   uint4 ps = pb->rng[path];
   int strat = !segment && ps.w == PATH_SAMPLER_SOBOL;
-  float2 u_point = strat ? path_sampler_2d(ps, PATH_DIM_LIGHT_POINT) : make_float2(0.0f, 0.0f);
   const LtTree* t = &ls->tree;
   if (HAS_INFINITE_LIGHT && !segment && it.code == 0 && ls->infinite_count > 0) {
     out.y = light_pick_infinite(ls, sc, pb, path, seed, shadows);
@@ -155,6 +154,7 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
       return out;
     }
     // Leaf: every contributing emitter is in the cut with probability 1.
+    float2 u_point = strat ? path_sampler_2d(ps, PATH_DIM_LIGHT_POINT) : make_float2(0.0f, 0.0f);
     int first = lt_leaf_first(it.code);
     for (int j = 0; j < lt_leaf_count(it.code); ++j) {
       if (!(f4_get(imp, j) > 0.0f)) continue;
@@ -174,9 +174,11 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
   float pmf;
   int light = light_sampler_pick_w(ls, it.code, &q, root, w, &rng, &pmf);
   out.z += 1;
-  if (light >= 0)
+  if (light >= 0) {
+    float2 u_point = strat ? path_sampler_2d(ps, PATH_DIM_LIGHT_POINT) : make_float2(0.0f, 0.0f);
     out.y += light_pick_items(ls, sc, pb, path, segment, light, pmf, strat, u_point, &rng,
                               &shadows[out.y]);
+  }
   return out;
 }
 

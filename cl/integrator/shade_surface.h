@@ -33,7 +33,7 @@ INLINE float shade_emission_weight(const LightSamplerCtx* ls, const SceneBuffers
                                    const PathBuffers* pb, int path, int depth, int light,
                                    float3 P) {
   float4 prev_P = pb->shade_P[path];
-  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == PATH_DIM_BSDF) return 1.0f;
+  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
   // A medium vertex: the phase technique against the segment's light samples (volume_light.h).
   if (HAS_MEDIUM && pb->shade_f[path].w == VOLUME_POINT_FLAG)
     return CANOPY_MIS ? volume_emission_weight(ls, sc, pb, path, light, P) : 0.0f;
@@ -52,7 +52,7 @@ INLINE float shade_emission_weight(const LightSamplerCtx* ls, const SceneBuffers
 INLINE float shade_environment_weight(const LightSamplerCtx* ls, const PathBuffers* pb, int path,
                                       int depth, const GLOBAL Light* l, float3 d) {
   float4 prev_P = pb->shade_P[path];
-  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == PATH_DIM_BSDF) return 1.0f;
+  if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
   if (!CANOPY_MIS) return 0.0f; // light sampling alone accounts for it
   return power_heuristic(prev_P.w, env_pdf(l, &ls->env, light_query_normal(pb, path), d));
 }
@@ -143,7 +143,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   int last = depth + 1 >= max_depth; // the BSDF ray only looks for emission (see the top)
   // Light shapes are black diffuse: nothing to pick lights for.
   int black = m.type == MATERIAL_DIFFUSE && !(max3(xyz_of(m.albedo)) > 0.0f);
-  out.y = (ls->light_count > 0 || ls->infinite_count > 0) && ls->kind != PATH_DIM_BSDF &&
+  out.y = (ls->light_count > 0 || ls->infinite_count > 0) && ls->kind != SAMPLER_BSDF &&
           bsdf_has_smooth_lobe(&m) && !black;
   float mis_flag = CANOPY_MIS ? 1.0f : 0.0f;
   if (HAS_MICROFACET && light_sampler_brdf(ls)) {
@@ -171,7 +171,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   // From the last vertex, only a ray whose emission gets a weight (shade_emission_weight).
   // (An environment light gives an escaped ray a weight at glossy points of the BRDF samplers too.)
   int env_weighs = CANOPY_MIS ? light_sampler_has_environment(ls) : 0;
-  if (last && !bs.is_delta && ls->kind != PATH_DIM_BSDF && !(mis_flag == 1.0f) && !env_weighs)
+  if (last && !bs.is_delta && ls->kind != SAMPLER_BSDF && !(mis_flag == 1.0f) && !env_weighs)
     return out;
   float3 wi = frame_to_world(&fr, bs.wi);
   // A direction to the other side of the geometric surface than the lobe's would leak light

@@ -76,7 +76,7 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
   }
   pb->rng[path] = ps;
   float t_free = medium_sample_distance(&m, u_free);
-  int lights = ls->light_count > 0 && ls->kind != PATH_DIM_BSDF && len > 0.0f && depth < max_depth;
+  int lights = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && len > 0.0f && depth < max_depth;
   pb->seg_o[path] = f4_from3(a, lights ? len : -1.0f);
   pb->seg_d[path] = f4_from3(d, t_free);
   pb->seg_beta[path] = f4_from3(beta, uint_as_float_(seed));
