@@ -117,9 +117,10 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
   }
   // sobol (cl/sampler.h): every light sample of a shading point takes its point from the vertex's
   // light-point dimensions (each light's estimate is stratified over the pixel's samples), and
-  // the root's pick its first word from the light-selection dimension. Split children, leaf lights
-  // and deeper levels of a descent draw from their own LtRng streams (a dimension cannot be
-  // shared by choices whose number depends on the cut); medium segments keep theirs entirely.
+  // the root's pick its first word from the light-selection dimension. The picks below split
+  // children and the deeper levels of a descent draw from their own LtRng streams (a dimension
+  // cannot serve choices whose number depends on the cut, nor a rescaled word keep their exact
+  // probabilities); medium segments keep their streams entirely.
   uint4 ps = pb->rng[path];
   int strat = !segment && ps.w == PATH_SAMPLER_SOBOL;
   const LtTree* t = &ls->tree;
