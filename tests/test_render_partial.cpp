@@ -154,4 +154,11 @@ TEST_P(PartialRender, TilesAndRangesMergeIntoTheFullRender) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, PartialRender,
                          ::testing::Combine(::testing::Values("glossy-cornell", "spiral-fog"),
-                                            ::testing::Values("independent", "sobol")));
+                                            ::testing::Values("independent", "sobol")),
+                         [](const auto& p) {
+                           std::string name =
+                               std::string(std::get<0>(p.param)) + "_" + std::get<1>(p.param);
+                           for (char& c : name)
+                             if (c == '-') c = '_';
+                           return name;
+                         });
