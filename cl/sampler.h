@@ -54,21 +54,30 @@ INLINE uint sampler_group_seed(uint key, uint dim) {
   return hash_u32(key ^ hash_u32(dim * 0x9e3779b9u + 0x68e31da4u));
 }
 
-// Component c (0 or 1) of sample `sample` of the group at `dim`, as a 32-bit fraction.
+// The group's shuffled sample index: a nested uniform (Owen) scramble of the index.
+INLINE uint sampler_shuffled_index(uint sample, uint g) {
+  return owen_scramble(sample, g);
+}
+// Component c (0 or 1) of sample `sample` of the group at `dim`, as a 32-bit fraction: Owen
+// scrambles of Sobol dimension c at the shuffled index. (Written with the scrambles' bit-reversed
+// core: reversing the index is Sobol dimension 0, and Owen scrambling reverses, permutes and
+// reverses back, so three bit reversals do what eight would.)
 INLINE uint sampler_sobol_word(uint key, uint sample, uint dim, int c) {
   uint g = sampler_group_seed(key, dim);
-  uint i = owen_scramble(sample, g); // the group's shuffle of the sample index
-  uint x = c ? sobol_dim1(i) : sobol_dim0(i);
-  return owen_scramble(x, hash_u32(g + (c ? 0x1b873593u : 0xcc9e2d51u)));
+  uint i = sampler_shuffled_index(sample, g); // dimension 0 of it is reverse(i)
+  uint r = c ? sobol_dim1_reversed(i) : i;    // the component, bit-reversed
+  return sobol_reverse_bits(
+      owen_permute_reversed(r, hash_u32(g + (c ? 0x1b873593u : 0xcc9e2d51u))));
 }
 INLINE float sampler_sobol_1d(uint key, uint sample, uint dim) {
   return sobol_to_float(sampler_sobol_word(key, sample, dim, 0));
 }
 INLINE float2 sampler_sobol_2d(uint key, uint sample, uint dim) {
   uint g = sampler_group_seed(key, dim);
-  uint i = owen_scramble(sample, g);
-  uint x = owen_scramble(sobol_dim0(i), hash_u32(g + 0xcc9e2d51u));
-  uint y = owen_scramble(sobol_dim1(i), hash_u32(g + 0x1b873593u));
+  uint i = sampler_shuffled_index(sample, g);
+  uint x = sobol_reverse_bits(owen_permute_reversed(i, hash_u32(g + 0xcc9e2d51u)));
+  uint y =
+      sobol_reverse_bits(owen_permute_reversed(sobol_dim1_reversed(i), hash_u32(g + 0x1b873593u)));
   return make_float2(sobol_to_float(x), sobol_to_float(y));
 }
 // A plain hash of (pixel, sample, dimension): a seed for counter-based streams.

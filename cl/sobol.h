@@ -34,26 +34,34 @@ INLINE uint sobol_dim0(uint i) {
 // mod 2: bit c of i flips the fraction's bit r (weight 2^-(r+1)) iff the bits of r are a subset of
 // those of c (Lucas' theorem; the direction numbers v_c = v_(c-1) ^ (v_(c-1) >> 1)). So bit r of
 // the bit-reversed result is the XOR of i's bits c over the supersets c of r: a superset transform
-// in five masked shifts, without loops or branches.
-INLINE uint sobol_dim1(uint i) {
+// in five masked shifts, without loops or branches. sobol_dim1_reversed is that transform.
+INLINE uint sobol_dim1_reversed(uint i) {
   uint y = i;
   y ^= (y >> 1) & 0x55555555u;
   y ^= (y >> 2) & 0x33333333u;
   y ^= (y >> 4) & 0x0f0f0f0fu;
   y ^= (y >> 8) & 0x00ff00ffu;
   y ^= (y >> 16) & 0x0000ffffu;
-  return sobol_reverse_bits(y);
+  return y;
+}
+INLINE uint sobol_dim1(uint i) {
+  return sobol_reverse_bits(sobol_dim1_reversed(i));
 }
 
-// Owen scramble of a 32-bit fraction v (bit 31 is 1/2) with a 32-bit seed.
-INLINE uint owen_scramble(uint v, uint seed) {
-  v = sobol_reverse_bits(v);
+// The scramble on bit-reversed values (Laine & Karras 2011's permutation with pbrt-v4's
+// constants): bit k of the result is bit k of v flipped by a hash of the bits below k.
+INLINE uint owen_permute_reversed(uint v, uint seed) {
   v ^= v * 0x3d20adeau;
   v += seed;
   v *= (seed >> 16) | 1u;
   v ^= v * 0x05526c56u;
   v ^= v * 0x53a22864u;
-  return sobol_reverse_bits(v);
+  return v;
+}
+
+// Owen scramble of a 32-bit fraction v (bit 31 is 1/2) with a 32-bit seed.
+INLINE uint owen_scramble(uint v, uint seed) {
+  return sobol_reverse_bits(owen_permute_reversed(sobol_reverse_bits(v), seed));
 }
 
 // A 32-bit fraction as a float in [0, 1): its top 24 bits (exact, never 1).

@@ -103,6 +103,24 @@ TEST(SobolPoints, OwenScrambleKeepsElementaryIntervals) {
   EXPECT_NE(owen_scramble(0x12345678u, 1u), owen_scramble(0x12345678u, 2u));
 }
 
+TEST(SobolPoints, SamplerWordsAreBurleysComposition) {
+  // Owen scramble of Sobol dimension c at the group's shuffled index, each scramble with its seed.
+  std::mt19937 rng(9);
+  for (int t = 0; t < 20000; ++t) {
+    const uint32_t key = uint32_t(rng()), sample = t % 2 ? uint32_t(rng()) : uint32_t(t),
+                   dim = uint32_t(rng() % 200);
+    const uint32_t g = sampler_group_seed(key, dim);
+    const uint32_t i = owen_scramble(sample, g);
+    const uint32_t x = owen_scramble(sobol_dim0(i), hash_u32(g + 0xcc9e2d51u));
+    const uint32_t y = owen_scramble(sobol_dim1(i), hash_u32(g + 0x1b873593u));
+    ASSERT_EQ(sampler_sobol_word(key, sample, dim, 0), x);
+    ASSERT_EQ(sampler_sobol_word(key, sample, dim, 1), y);
+    float2 f = sampler_sobol_2d(key, sample, dim);
+    ASSERT_EQ(f.x, sobol_to_float(x));
+    ASSERT_EQ(f.y, sobol_to_float(y));
+  }
+}
+
 TEST(SobolPoints, ScrambledGroupsAreNetsInEveryPixelAndBlock) {
   for (uint32_t seed : {1u, 7u})
     for (uint32_t pixel : {0u, 1u, 513u, 99999u})
