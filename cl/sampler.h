@@ -13,8 +13,8 @@
 // the light samplers' counter-based streams (LtRng: split children, leaf lights, BRDF rounds,
 // medium segments) are plain hashes of (pixel, sample, dimension): not stratified.
 // The path state keeps one uint4 per path (PathBuffers.rng): x: the PCG state (independent) or
-// the pixel's scramble key (sobol), y: the sample index, z: the first dimension of the current
-// vertex, w: the sampler (PATH_SAMPLER_*).
+// the pixel's scramble key (sobol), y: the sample index bit-reversed (sobol), z: the first
+// dimension of the current vertex (sobol), w: the sampler (PATH_SAMPLER_*).
 #ifndef CANOPY_CL_SAMPLER_H
 #define CANOPY_CL_SAMPLER_H
 
@@ -49,48 +49,58 @@ INLINE uint sampler_pixel_key(uint seed, uint pixel) {
   return hash_u32(seed ^ 0x5851f42du ^ hash_u32(pixel * 0x2c1b3c6du + 0x297a2d39u));
 }
 
-// The seed of the group that starts at dimension `dim` of a pixel.
+// The seed of the group that starts at dimension `dim` of a pixel (key: a hash already).
 INLINE uint sampler_group_seed(uint key, uint dim) {
-  return hash_u32(key ^ hash_u32(dim * 0x9e3779b9u + 0x68e31da4u));
+  return hash_u32(key ^ (dim * 0x9e3779b9u + 0x68e31da4u));
+}
+// The seed of component c's scramble in the group of seed g.
+INLINE uint sampler_component_seed(uint g, int c) {
+  return (g ^ (c ? 0x1b873593u : 0xcc9e2d51u)) * 0x9e3779b9u;
 }
 
-// The group's shuffled sample index: a nested uniform (Owen) scramble of the index.
-INLINE uint sampler_shuffled_index(uint sample, uint g) {
-  return owen_scramble(sample, g);
-}
-// Component c (0 or 1) of sample `sample` of the group at `dim`, as a 32-bit fraction: Owen
-// scrambles of Sobol dimension c at the shuffled index. (Written with the scrambles' bit-reversed
-// core: reversing the index is Sobol dimension 0, and Owen scrambling reverses, permutes and
-// reverses back, so three bit reversals do what eight would.)
-INLINE uint sampler_sobol_word(uint key, uint sample, uint dim, int c) {
+// Component c (0 or 1) of a sample of the group at `dim`, as a 32-bit fraction: Owen scrambles of
+// Sobol dimension c at the group's shuffled index, the nested uniform (Owen) scramble of the
+// sample index. The *_r forms take the sample index bit-reversed (as the path state keeps it):
+// the scrambles permute bit-reversed values, and reversing the shuffled index is Sobol dimension
+// 0, so a component costs two bit reversals.
+INLINE uint sampler_sobol_word_r(uint key, uint rsample, uint dim, int c) {
   uint g = sampler_group_seed(key, dim);
-  uint i = sampler_shuffled_index(sample, g); // dimension 0 of it is reverse(i)
-  uint r = c ? sobol_dim1_reversed(i) : i;    // the component, bit-reversed
-  return sobol_reverse_bits(
-      owen_permute_reversed(r, hash_u32(g + (c ? 0x1b873593u : 0xcc9e2d51u))));
+  uint i = sobol_reverse_bits(owen_permute_reversed(rsample, g)); // the shuffled index
+  uint r = c ? sobol_dim1_reversed(i) : i;                        // the component, bit-reversed
+  return sobol_reverse_bits(owen_permute_reversed(r, sampler_component_seed(g, c)));
+}
+INLINE float2 sampler_sobol_2d_r(uint key, uint rsample, uint dim) {
+  uint g = sampler_group_seed(key, dim);
+  uint i = sobol_reverse_bits(owen_permute_reversed(rsample, g));
+  uint x = sobol_reverse_bits(owen_permute_reversed(i, sampler_component_seed(g, 0)));
+  uint y = sobol_reverse_bits(
+      owen_permute_reversed(sobol_dim1_reversed(i), sampler_component_seed(g, 1)));
+  return make_float2(sobol_to_float(x), sobol_to_float(y));
+}
+// A plain hash of (pixel, sample, dimension): a seed for counter-based streams.
+INLINE uint sampler_hash_word_r(uint key, uint rsample, uint dim) {
+  return hash_u32(hash_u32(key ^ rsample) + dim * 0x85ebca6bu);
+}
+INLINE uint sampler_sobol_word(uint key, uint sample, uint dim, int c) {
+  return sampler_sobol_word_r(key, sobol_reverse_bits(sample), dim, c);
 }
 INLINE float sampler_sobol_1d(uint key, uint sample, uint dim) {
   return sobol_to_float(sampler_sobol_word(key, sample, dim, 0));
 }
 INLINE float2 sampler_sobol_2d(uint key, uint sample, uint dim) {
-  uint g = sampler_group_seed(key, dim);
-  uint i = sampler_shuffled_index(sample, g);
-  uint x = sobol_reverse_bits(owen_permute_reversed(i, hash_u32(g + 0xcc9e2d51u)));
-  uint y =
-      sobol_reverse_bits(owen_permute_reversed(sobol_dim1_reversed(i), hash_u32(g + 0x1b873593u)));
-  return make_float2(sobol_to_float(x), sobol_to_float(y));
+  return sampler_sobol_2d_r(key, sobol_reverse_bits(sample), dim);
 }
-// A plain hash of (pixel, sample, dimension): a seed for counter-based streams.
 INLINE uint sampler_hash_word(uint key, uint sample, uint dim) {
-  return hash_u32(key ^ hash_u32(sample ^ hash_u32(dim + 0x3c6ef372u)));
+  return sampler_hash_word_r(key, sobol_reverse_bits(sample), dim);
 }
 
 // The state of a new path and its position in the pixel (jitter).
 INLINE uint4 path_sampler_start(uint kind, uint seed, uint pixel, uint sample, float2* jitter) {
   if (kind == PATH_SAMPLER_SOBOL) {
     uint key = sampler_pixel_key(seed, pixel);
-    *jitter = sampler_sobol_2d(key, sample, PATH_DIM_PIXEL);
-    return make_uint4(key, sample, PATH_DIM_VERTEX0, kind);
+    uint rsample = sobol_reverse_bits(sample);
+    *jitter = sampler_sobol_2d_r(key, rsample, PATH_DIM_PIXEL);
+    return make_uint4(key, rsample, PATH_DIM_VERTEX0, kind);
   }
   PathRng r = rng_seed(seed, pixel, sample);
   float jx = rng_next_float(&r);
@@ -101,16 +111,16 @@ INLINE uint4 path_sampler_start(uint kind, uint seed, uint pixel, uint sample, f
 
 // The numbers of the vertex whose dimensions start at s.z (sobol only).
 INLINE float path_sampler_1d(uint4 s, uint offset) {
-  return sampler_sobol_1d(s.x, s.y, s.z + offset);
+  return sobol_to_float(sampler_sobol_word_r(s.x, s.y, s.z + offset, 0));
 }
 INLINE float2 path_sampler_2d(uint4 s, uint offset) {
-  return sampler_sobol_2d(s.x, s.y, s.z + offset);
+  return sampler_sobol_2d_r(s.x, s.y, s.z + offset);
 }
 INLINE uint path_sampler_word(uint4 s, uint offset) {
-  return sampler_sobol_word(s.x, s.y, s.z + offset, 0);
+  return sampler_sobol_word_r(s.x, s.y, s.z + offset, 0);
 }
 INLINE uint path_sampler_hash(uint4 s, uint offset) {
-  return sampler_hash_word(s.x, s.y, s.z + offset);
+  return sampler_hash_word_r(s.x, s.y, s.z + offset);
 }
 
 #endif // CANOPY_CL_SAMPLER_H

@@ -6,8 +6,15 @@
 //   2^k samples fall one in each interval of width 2^-k;
 // - scrambled values are uniform over pixels (chi-square, fixed keys) and padded groups of one
 //   pixel are independent of each other (chi-square of a joint histogram).
+// - a light pick whose first word is the light-selection dimension's (the root pick, sobol) keeps
+//   exactly its pmf: over many pixels' samples, each light is picked with the probability the
+//   sampler reports (chi-square), for uniform, power and tree.
 // The device draws the same numbers (test_kernel_sampler.cpp).
+#include "integrator/light_sampler.h"
+#include "light_tree/synthetic_lights.h"
+#include "render/light_sampler_data.h"
 #include "sampler.h"
+#include "test_light_tree_util.h"
 
 #include <gtest/gtest.h>
 
@@ -111,8 +118,8 @@ TEST(SobolPoints, SamplerWordsAreBurleysComposition) {
                    dim = uint32_t(rng() % 200);
     const uint32_t g = sampler_group_seed(key, dim);
     const uint32_t i = owen_scramble(sample, g);
-    const uint32_t x = owen_scramble(sobol_dim0(i), hash_u32(g + 0xcc9e2d51u));
-    const uint32_t y = owen_scramble(sobol_dim1(i), hash_u32(g + 0x1b873593u));
+    const uint32_t x = owen_scramble(sobol_dim0(i), sampler_component_seed(g, 0));
+    const uint32_t y = owen_scramble(sobol_dim1(i), sampler_component_seed(g, 1));
     ASSERT_EQ(sampler_sobol_word(key, sample, dim, 0), x);
     ASSERT_EQ(sampler_sobol_word(key, sample, dim, 1), y);
     float2 f = sampler_sobol_2d(key, sample, dim);
@@ -215,13 +222,61 @@ TEST(PathSampler, IndependentIsThePcgStream) {
   EXPECT_EQ(s.x, r.state);
   EXPECT_EQ(s.w, PATH_SAMPLER_INDEPENDENT);
   // sobol: the pixel's key, the sample index, the first vertex's dimensions; the jitter is the
-  // pixel group's point.
+  // pixel group's point, and the vertex numbers are the groups' at the vertex's dimensions.
   s = path_sampler_start(PATH_SAMPLER_SOBOL, 5u, 77u, 9u, &j);
   float2 p = sampler_sobol_2d(sampler_pixel_key(5u, 77u), 9u, PATH_DIM_PIXEL);
   EXPECT_EQ(j.x, p.x);
   EXPECT_EQ(j.y, p.y);
   EXPECT_EQ(s.x, sampler_pixel_key(5u, 77u));
-  EXPECT_EQ(s.y, 9u);
+  EXPECT_EQ(s.y, sobol_reverse_bits(9u)); // the sample index, bit-reversed
   EXPECT_EQ(s.z, uint32_t(PATH_DIM_VERTEX0));
   EXPECT_EQ(s.w, PATH_SAMPLER_SOBOL);
+  const uint32_t key = sampler_pixel_key(5u, 77u), base = uint32_t(PATH_DIM_VERTEX0);
+  EXPECT_EQ(path_sampler_word(s, 3u), sampler_sobol_word(key, 9u, base + 3u, 0));
+  EXPECT_EQ(path_sampler_1d(s, 4u), sampler_sobol_1d(key, 9u, base + 4u));
+  float2 a = path_sampler_2d(s, 5u), b = sampler_sobol_2d(key, 9u, base + 5u);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(path_sampler_hash(s, 6u), sampler_hash_word(key, 9u, base + 6u));
+}
+
+TEST(PathSampler, PicksWithSobolFirstWordsKeepThePmf) {
+  const std::vector<Light> lights = canopy::mixed_lights(400, 13, 10.0f);
+  const float3 P = make_float3(1.0f, 2.0f, 0.5f), N = normalize(make_float3(0.2f, 1.0f, -0.3f));
+  const LtQuery q = lt_query_point(P, N);
+  const uint32_t dim = sampler_vertex_base(0) + PATH_DIM_LIGHT_SELECT;
+  for (const char* name : {"uniform", "power", "tree"}) {
+    SCOPED_TRACE(name);
+    canopy::LightSamplerData data = canopy::make_light_sampler_data(lights, name, 0.0f, 1);
+    LightSamplerCtx ls = data.host_view(lights);
+    std::vector<double> prob(lights.size()), counts(lights.size(), 0.0);
+    for (size_t l = 0; l < lights.size(); ++l)
+      prob[l] = light_sampler_pmf_q(&ls, &q, int(l));
+    // 64 samples of each of 3125 pixels: the words of one pixel are stratified, the pixels'
+    // scrambles independent.
+    const int pixels = 3125, spp = 64;
+    int total = 0, mismatched = 0;
+    for (int p = 0; p < pixels; ++p)
+      for (int k = 0; k < spp; ++k) {
+        const uint32_t key = sampler_pixel_key(21u, uint32_t(p));
+        LtRng rng = lt_rng_make(sampler_hash_word(key, uint32_t(k), dim), 0u);
+        float pmf = 0.0f;
+        int l = light_sampler_pick_w(&ls, 0, &q, 1, sampler_sobol_word(key, uint32_t(k), dim, 0),
+                                     &rng, &pmf);
+        if (l < 0) continue;
+        counts[size_t(l)] += 1.0;
+        ++total;
+        mismatched += pmf != float(prob[size_t(l)]);
+      }
+    EXPECT_EQ(mismatched, 0);
+    int dof = 0;
+    double z = canopy::test::chi2_score(counts, prob, double(total), &dof);
+    EXPECT_LT(z, 5.0) << "dof " << dof;
+    EXPECT_GT(dof, 100);
+    // The test can fail: a pmf off by a few percent on a tenth of the lights.
+    std::vector<double> wrong = prob;
+    for (size_t l = 0; l < wrong.size(); l += 10)
+      wrong[l] *= 1.2;
+    EXPECT_GT(canopy::test::chi2_score(counts, wrong, double(total)), 5.0);
+  }
 }
