@@ -187,6 +187,7 @@ protected:
             make_uint4(uint32_t(rng()), uint32_t(rng() % 4096), 0u, PATH_SAMPLER_SOBOL));
       else
         p.rng.push_back(make_uint4(uint32_t(rng()), 0u, 0u, PATH_SAMPLER_INDEPENDENT));
+      p.light_u.push_back(make_float2(0.0f, 0.0f)); // (shade_surface writes it for sobol)
       // Previous vertex: a point in the room, a normal, and the pdf of the BSDF ray (0: none).
       float3 sp = make_float3(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng)) - origin_;
       p.shade_P.push_back(f4_from3(sp, i % 3 == 0 ? 0.0f : u(rng)));
@@ -262,6 +263,8 @@ void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& w
     expect_close4(dev.radiance[p], ref.radiance[p], at + " radiance");
     expect_close4(dev.shade_P[p], ref.shade_P[p], at + " shade_P");
     EXPECT_EQ(dev.rng[p], ref.rng[p]) << at;
+    EXPECT_EQ(dev.light_u[p].x, ref.light_u[p].x) << at;
+    EXPECT_EQ(dev.light_u[p].y, ref.light_u[p].y) << at;
     expect_close(dev.shade_N[p].x, ref.shade_N[p].x, at + " N");
     EXPECT_EQ(float_as_uint_(dev.shade_N[p].w), float_as_uint_(ref.shade_N[p].w)) << at << " seed";
     expect_close4(dev.shade_f[p], ref.shade_f[p], at + " shade_f");

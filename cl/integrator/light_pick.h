@@ -116,13 +116,12 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
     seed = float_as_uint_(pb->shade_N[path].w);
   }
   // sobol (cl/sampler.h): every light sample of a shading point takes its point from the vertex's
-  // light-point dimensions (each light's estimate is stratified over the pixel's samples), and
-  // the root's pick its first word from the light-selection dimension. The picks below split
-  // children and the deeper levels of a descent draw from their own LtRng streams (a dimension
-  // cannot serve choices whose number depends on the cut, nor a rescaled word keep their exact
-  // probabilities); medium segments keep their streams entirely.
-  uint4 ps = pb->rng[path];
-  int strat = !segment && ps.w == PATH_SAMPLER_SOBOL;
+  // light-point dimensions (light_u, drawn once by shade_surface: each light's estimate is
+  // stratified over the pixel's samples), and the root's pick its first word from the
+  // light-selection dimension. The picks below split children and the deeper levels of a descent
+  // draw from their own LtRng streams (a dimension cannot serve choices whose number depends on the
+  // cut, nor a rescaled word keep their exact probabilities); medium segments keep theirs entirely.
+  int strat = !segment && pb->rng[path].w == PATH_SAMPLER_SOBOL;
   const LtTree* t = &ls->tree;
   if (HAS_INFINITE_LIGHT && !segment && it.code == 0 && ls->infinite_count > 0) {
     out.y = light_pick_infinite(ls, sc, pb, path, seed, shadows);
@@ -155,7 +154,7 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
       return out;
     }
     // Leaf: every contributing emitter is in the cut with probability 1.
-    float2 u_point = strat ? path_sampler_2d(ps, PATH_DIM_LIGHT_POINT) : make_float2(0.0f, 0.0f);
+    float2 u_point = strat ? pb->light_u[path] : make_float2(0.0f, 0.0f);
     int first = lt_leaf_first(it.code);
     for (int j = 0; j < lt_leaf_count(it.code); ++j) {
       if (!(f4_get(imp, j) > 0.0f)) continue;
@@ -171,12 +170,12 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
   // One stochastic pick below the item (codes are unique within a cut: one stream each).
   LtRng rng = lt_rng_make(seed, (uint)it.code);
   int root = strat && it.code == 0;
-  uint w = root ? path_sampler_word(ps, PATH_DIM_LIGHT_SELECT) : 0u;
+  uint w = root ? path_sampler_word(pb->rng[path], PATH_DIM_LIGHT_SELECT) : 0u;
   float pmf;
   int light = light_sampler_pick_w(ls, it.code, &q, root, w, &rng, &pmf);
   out.z += 1;
   if (light >= 0) {
-    float2 u_point = strat ? path_sampler_2d(ps, PATH_DIM_LIGHT_POINT) : make_float2(0.0f, 0.0f);
+    float2 u_point = strat ? pb->light_u[path] : make_float2(0.0f, 0.0f);
     out.y += light_pick_items(ls, sc, pb, path, segment, light, pmf, strat, u_point, &rng,
                               &shadows[out.y]);
   }

@@ -128,6 +128,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
     u2 = ub.y;
     u_rr = path_sampler_1d(ps, PATH_DIM_RR);
     u3 = path_sampler_1d(ps, PATH_DIM_LOBE);
+    pb->light_u[path] = path_sampler_2d(ps, PATH_DIM_LIGHT_POINT); // once for the whole cut
   } else {
     PathRng r;
     r.state = ps.x;
