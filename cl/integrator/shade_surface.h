@@ -126,8 +126,10 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
     float2 ub = path_sampler_2d(ps, PATH_DIM_BSDF);
     u1 = ub.x;
     u2 = ub.y;
-    u_rr = path_sampler_1d(ps, PATH_DIM_RR);
-    u3 = path_sampler_1d(ps, PATH_DIM_LOBE);
+    // (only where they are read: Russian roulette from depth 2, cl/shading.h; a lobe choice
+    // except on diffuse surfaces)
+    u_rr = depth >= 2 ? path_sampler_1d(ps, PATH_DIM_RR) : 0.0f;
+    u3 = m.type != MATERIAL_DIFFUSE ? path_sampler_1d(ps, PATH_DIM_LOBE) : 0.0f;
     pb->light_u[path] = path_sampler_2d(ps, PATH_DIM_LIGHT_POINT); // once for the whole cut
   } else {
     PathRng r;

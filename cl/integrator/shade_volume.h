@@ -63,7 +63,7 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
     float2 up = path_sampler_2d(ps, PATH_DIM_PHASE);
     u1 = up.x;
     u2 = up.y;
-    u_rr = path_sampler_1d(ps, PATH_DIM_MEDIUM_RR);
+    u_rr = depth >= 2 ? path_sampler_1d(ps, PATH_DIM_MEDIUM_RR) : 0.0f; // read from depth 2
   } else {
     PathRng r;
     r.state = ps.x;
