@@ -1,5 +1,6 @@
-// Image textures (cl/types.h Texture): bilinear lookup, as pbrt-v4's ImageTexture with its default
-// "bilinear" filter (one level, no MIP maps), and a material's textured albedo and alpha at a
+// Textures (cl/types.h Texture): image nodes looked up bilinearly, as pbrt-v4's ImageTexture with
+// its default "bilinear" filter (one level, no MIP maps), constants, and pbrt-v4's checkerboard,
+// mix and scale over them, evaluated as a postfix program; and a material's textured values at a
 // triangle hit. Compiled into the kernels only for scenes with a textured material (HAS_TEXTURES).
 #ifndef CANOPY_CL_TEXTURE_H
 #define CANOPY_CL_TEXTURE_H
@@ -58,6 +59,63 @@ INLINE float3 texture_lookup(GLOBAL const Texture* t, GLOBAL const float* texels
   return c * xyz_of(t->scale);
 }
 
+// The parity of floor(x) (0 even, 1 odd) without an int conversion that could overflow; a
+// non-finite x counts as even.
+INLINE int texture_floor_odd(float x) {
+  if (!is_finite_f(x)) return 0;
+  float f = floor(x);
+  return f - 2.0f * floor(0.5f * f) != 0.0f;
+}
+
+// pbrt-v4's 2D checkerboard weight of its second input at (u, v): 0 where floor(s) + floor(t) is
+// even, 1 where it is odd ((s, t) = the node's uv mapping). pbrt-v4 box-filters the edges with the
+// ray differentials' footprint; without differentials (Canopy has none) its weight is this.
+INLINE float texture_checker_weight(GLOBAL const Texture* t, float2 uv) {
+  float s = t->uvmap.x * uv.x + t->uvmap.z;
+  float tt = t->uvmap.y * uv.y + t->uvmap.w;
+  return (texture_floor_odd(s) ^ texture_floor_odd(tt)) ? 1.0f : 0.0f;
+}
+
+// The value at (u, v) of the texture whose root is textures[root] (its tree is the root's `nodes`
+// records ending at it, in postfix order: every node pops its inputs and pushes its value).
+INLINE float3 texture_eval(GLOBAL const Texture* textures, GLOBAL const float* texels, int root,
+                           float2 uv) {
+  float3 stack[TEXTURE_STACK];
+  int top = 0;
+  // (a zero-initialised record, nodes 0, is an image alone)
+  const int first = root - max(textures[root].nodes, 1) + 1;
+  for (int i = first; i <= root; ++i) {
+    GLOBAL const Texture* t = &textures[i];
+    float3 v;
+    if (t->kind == TEXTURE_IMAGE) {
+      v = texture_lookup(t, texels, uv);
+    } else if (t->kind == TEXTURE_CONSTANT) {
+      v = xyz_of(t->scale);
+    } else if (t->kind == TEXTURE_CHECKERBOARD) {
+      top -= 2;
+      v = texture_checker_weight(t, uv) > 0.0f ? stack[top + 1] : stack[top];
+    } else if (t->kind == TEXTURE_MIX) {
+      top -= 3;
+      float a = stack[top + 2].x;
+      v = stack[top] * (1.0f - a) + stack[top + 1] * a;
+    } else { // TEXTURE_SCALE
+      top -= 2;
+      v = stack[top] * stack[top + 1];
+    }
+    if (top < 0 || top >= TEXTURE_STACK) return make_float3(0.0f, 0.0f, 0.0f); // malformed
+    stack[top++] = v;
+  }
+  return top == 1 ? stack[0] : make_float3(0.0f, 0.0f, 0.0f);
+}
+
+// A reflectance or transmittance texture's value, clamped to [0, 1] as pbrt-v4's materials do (a
+// value above 1 would create energy).
+INLINE float3 texture_reflectance(GLOBAL const Texture* textures, GLOBAL const float* texels,
+                                  int root, float2 uv) {
+  float3 a = texture_eval(textures, texels, root, uv);
+  return fmin(fmax(a, make_float3(0.0f, 0.0f, 0.0f)), make_float3(1.0f, 1.0f, 1.0f));
+}
+
 // GGX alpha from a float texture's value r (TEXTURE_MAP_*), at most 1 (Canopy's GGX range, as the
 // scene readers clamp constant roughness); a negative or NaN r gives 0 (a mirror).
 INLINE float texture_alpha(int map, float r) {
@@ -74,23 +132,23 @@ INLINE float2 triangle_uv(GLOBAL const float2* texcoords, int tri, float bu, flo
   return make_float2(w * a.x + bu * b.x + bv * c.x, w * a.y + bu * b.y + bv * c.y);
 }
 
-// Replaces the albedo and alpha of `m`, the material of scene triangle `tri` hit at barycentrics
-// (bu, bv), by its textures' values there (albedo clamped to [0, 1]). Only textured materials call it (Material's
-// albedo_texture, alpha_texture: 1 + a texture index), and only scene triangles have them.
+// Replaces the albedo, alpha and transmittance of `m`, the material of scene triangle `tri` hit at
+// barycentrics (bu, bv), by its textures' values there (reflectances clamped to [0, 1]). Only
+// textured materials call it (Material's albedo_texture, alpha_texture, transmittance_texture:
+// 1 + the index of a texture's root), and only scene triangles have them.
 INLINE void material_apply_textures(Material* m, GLOBAL const float2* texcoords,
                                     GLOBAL const Texture* textures, GLOBAL const float* texels,
                                     int tri, float bu, float bv) {
   float2 uv = triangle_uv(texcoords, tri, bu, bv);
-  if (m->albedo_texture > 0) {
-    // A reflectance above 1 would create energy: clamped to [0, 1] as pbrt-v4's materials do.
-    float3 a = texture_lookup(&textures[m->albedo_texture - 1], texels, uv);
-    a = fmin(fmax(a, make_float3(0.0f, 0.0f, 0.0f)), make_float3(1.0f, 1.0f, 1.0f));
-    m->albedo = f4_from3(a, 0.0f);
-  }
+  if (m->albedo_texture > 0)
+    m->albedo = f4_from3(texture_reflectance(textures, texels, m->albedo_texture - 1, uv), 0.0f);
   if (m->alpha_texture > 0) {
-    GLOBAL const Texture* t = &textures[m->alpha_texture - 1];
-    m->alpha = texture_alpha(t->map, texture_lookup(t, texels, uv).x);
+    int root = m->alpha_texture - 1;
+    m->alpha = texture_alpha(textures[root].map, texture_eval(textures, texels, root, uv).x);
   }
+  if (m->transmittance_texture > 0)
+    m->specular =
+        f4_from3(texture_reflectance(textures, texels, m->transmittance_texture - 1, uv), 0.0f);
 }
 
 #endif // CANOPY_CL_TEXTURE_H

@@ -78,11 +78,21 @@ typedef struct Light {
 // `base_alpha`, with an optional scattering medium between them. Opaque, seen from the top only.
 #define MATERIAL_COATED_DIFFUSE 5
 #define MATERIAL_COATED_CONDUCTOR 6
+// pbrt-v4's mix: one of two materials (mix_material) per shading point, the second with
+// probability mix_amount (or its float texture's value there), chosen by a hash of the point and
+// wo (cl/material_mix.h). Resolved before any BSDF use; never reaches the BSDF code.
+#define MATERIAL_MIX 7
+// pbrt-v4's diffusetransmission: reflectance albedo / pi on wo's side and transmittance
+// `specular` / pi on the other (cl/bsdf/diffuse_transmission.h). Light reaches it from both
+// sides.
+#define MATERIAL_DIFFUSE_TRANSMISSION 8
+// Mixes nest at most this deep (the loaders refuse deeper chains; the device resolves in a loop).
+#define MATERIAL_MIX_MAX_DEPTH 8
 
 typedef struct Material {
   float4 albedo;   // diffuse, plastic, coated diffuse: diffuse reflectance rgb in [0,1]
   float4 specular; // plastic: specular scale rgb; conductor, coated conductor: eta (real part of
-                   // the conductor's index) rgb
+                   // the conductor's index) rgb; diffuse transmission: transmittance rgb
   float4 k;        // conductor, coated conductor: k (imaginary part of the index) rgb
   float4 medium;   // coated: scattering albedo rgb of the layer between coat and base (0: it
                    // only absorbs); its Henyey-Greenstein g (w)
@@ -105,30 +115,51 @@ typedef struct Material {
   // pbrt-v4's MediumInterface "" "fog"): a ray leaving into that inside travels outside the
   // medium (shade_surface.h).
   int excludes_medium;
-  int pad1, pad2;
+  // mix: the two materials (indices into the scene's materials), the probability of choosing the
+  // second and 1 + the index of the float texture that replaces it (0: none).
+  int mix_material[2];
+  float mix_amount;
+  int mix_amount_texture;
+  // diffuse transmission: 1 + the index of the texture that replaces `specular` (0: none).
+  int transmittance_texture;
+  int pad0;
 } Material;
 
-// ---------------------------------------------------------------- image textures
-// An image texture (cl/texture.h): bilinearly filtered texels of one image, looked up at a
-// triangle's interpolated (u, v). The image's row 0 is its top and t = 0 its bottom, as in pbrt-v4
-// and OBJ: texel coordinates are (s w, (1 - t) h) for (s, t) = uvmap applied to (u, v).
+// ---------------------------------------------------------------- textures
+// A texture is a small expression over the triangle's interpolated (u, v) (cl/texture.h): a tree
+// of nodes stored in postfix order, each node right after its inputs' subtrees. A material refers
+// to its root; the root's `nodes` counts the records of the whole tree (1 for an image alone), so
+// the tree is the `nodes` records ending at the root. Evaluation keeps a stack of at most
+// TEXTURE_STACK values (the loaders refuse deeper trees).
+#define TEXTURE_IMAGE 0    // bilinearly filtered texels of one image, times `scale`
+#define TEXTURE_CONSTANT 1 // `scale` itself (rgb; a float texture has x = y = z)
+// pbrt-v4's 2D checkerboard on (s, t) = uvmap applied to (u, v): its first input where
+// floor(s) + floor(t) is even, its second where it is odd (no antialiasing filter).
+#define TEXTURE_CHECKERBOARD 2
+#define TEXTURE_MIX 3   // pbrt-v4's mix: (1 - a) first + a second, a = the third input's x
+#define TEXTURE_SCALE 4 // pbrt-v4's scale: the first input times the second
+#define TEXTURE_STACK 8
+// An image node's lookup: the image's row 0 is its top and t = 0 its bottom, as in pbrt-v4 and
+// OBJ: texel coordinates are (s w, (1 - t) h) for (s, t) = uvmap applied to (u, v).
 #define TEXTURE_WRAP_REPEAT 0 // s, t taken modulo 1
 #define TEXTURE_WRAP_CLAMP 1  // texel coordinates clamped to the image
 #define TEXTURE_WRAP_BLACK 2  // texels outside the image are 0
-// What a float texture's filtered value r means for GGX alpha (Texture::map; rgb textures: 0).
+// What a float texture's value r means for GGX alpha (Texture::map of the root; rgb textures: 0).
 #define TEXTURE_MAP_VALUE 0        // the value itself (rgb reflectance, or alpha)
 #define TEXTURE_MAP_ALPHA_SQUARE 1 // Canopy's roughness: alpha = r^2 (scene.h conductor_material)
 #define TEXTURE_MAP_ALPHA_SQRT 2   // pbrt-v4's remapped roughness: alpha = sqrt(r)
 
 typedef struct Texture {
-  float4 scale; // multiplies the filtered value (rgb; a float texture uses x), before `map`
-  float4 uvmap; // (s, t) = (x u + z, y v + w): pbrt-v4's uv mapping su, sv, du, dv
-  int first;    // index in the texel buffer of the first channel of the image's first texel
+  float4 scale; // image: multiplies the filtered value (rgb; a float texture uses x); constant:
+                // the value
+  float4 uvmap; // image, checkerboard: (s, t) = (x u + z, y v + w): pbrt-v4's su, sv, du, dv
+  int first;    // image: index in the texel buffer of the first channel of its first texel
   int width, height;
-  int channels; // 3: rgb texels; 1: one float per texel
-  int wrap;     // TEXTURE_WRAP_*
-  int map;      // TEXTURE_MAP_*
-  int pad0, pad1;
+  int channels; // image: 3: rgb texels; 1: one float per texel
+  int wrap;     // image: TEXTURE_WRAP_*
+  int map;      // TEXTURE_MAP_* (read at the root)
+  int kind;     // TEXTURE_*
+  int nodes;    // records of the tree ending at this node (itself and its inputs' subtrees)
 } Texture;
 
 // ---------------------------------------------------------------- participating media

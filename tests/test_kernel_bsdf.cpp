@@ -69,6 +69,14 @@ Material plastic(float alpha) {
 Material diffuse() {
   return make_diffuse(make_float3(0.8f, 0.5f, 0.2f));
 }
+// Diffuse transmission (pbrt-v4's defaults, and a coloured one that mostly transmits).
+Material transmitter(float3 r, float3 t) {
+  Material m{};
+  m.type = MATERIAL_DIFFUSE_TRANSMISSION;
+  m.albedo = f4_from3(r, 0.0f);
+  m.specular = f4_from3(t, 0.0f);
+  return m;
+}
 
 struct Probes {
   std::vector<Material> mats;
@@ -245,7 +253,9 @@ void run_probes(ClRuntime& rt, const std::string& options, const std::vector<Mat
 }
 
 std::vector<Material> all_materials() {
-  std::vector<Material> v = {diffuse()};
+  std::vector<Material> v = {
+      diffuse(), transmitter(make_float3(0.25f, 0.25f, 0.25f), make_float3(0.25f, 0.25f, 0.25f)),
+      transmitter(make_float3(0.1f, 0.3f, 0.2f), make_float3(0.8f, 0.6f, 0.7f))};
   for (float a : {0.0f, 1e-4f, 0.01f, 0.09f, 1.0f}) {
     v.push_back(conductor(a));
     v.push_back(plastic(a));
@@ -273,8 +283,9 @@ std::vector<Material> all_materials() {
 }
 
 std::string features(bool conductor_on, bool plastic_on, bool dielectric_on = false,
-                     bool coated_on = false) {
+                     bool coated_on = false, bool transmission_on = false) {
   KernelFeatures f;
+  f.material_diffuse_transmission = transmission_on;
   f.material_conductor = conductor_on;
   f.material_plastic = plastic_on;
   f.material_dielectric = dielectric_on;
@@ -293,8 +304,9 @@ TEST(KernelBsdf, EveryMaterialMatchesHost) {
 // a feature only removes code for types the scene does not have).
 TEST(KernelBsdf, SpecialisedKernelsMatchHost) {
   ClRuntime rt;
-  std::vector<Material> conductors, plastics, glass, coated;
+  std::vector<Material> conductors, plastics, glass, coated, transmitters;
   for (const Material& m : all_materials()) {
+    if (m.type == MATERIAL_DIFFUSE_TRANSMISSION) transmitters.push_back(m);
     if (m.type == MATERIAL_CONDUCTOR) conductors.push_back(m);
     if (m.type == MATERIAL_PLASTIC) plastics.push_back(m);
     if (m.type == MATERIAL_DIELECTRIC || m.type == MATERIAL_THIN_DIELECTRIC) glass.push_back(m);
@@ -305,4 +317,6 @@ TEST(KernelBsdf, SpecialisedKernelsMatchHost) {
   run_probes(rt, features(false, true), plastics, 4);
   run_probes(rt, features(false, false, true), glass, 5);         // glass: no BRDF-glossy code
   run_probes(rt, features(false, false, false, true), coated, 6); // coated alone
+  // diffuse transmission alone: no GGX code either
+  run_probes(rt, features(false, false, false, false, true), transmitters, 7);
 }

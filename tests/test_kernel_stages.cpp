@@ -198,6 +198,8 @@ protected:
       p.shade_wo.push_back(make_float4(0, 0, 0, 0));
       p.shade_Ns.push_back(make_float4(0, 0, 0, 0));
       p.shade_tex.push_back(make_float4(0, 0, 0, 0));
+      p.shade_tex_t.push_back(make_float4(0, 0, 0, 0));
+      p.shade_back.push_back(make_float4(0, 0, 0, 0)); // previous vertices one-sided
       p.brdf_state.push_back(make_int4(0, 0, 0, 0));
       p.brdf_share.push_back(0.0f);
       p.seg_o.push_back(make_float4(0, 0, 0, -1));
@@ -701,23 +703,49 @@ protected:
                                  KernelFeatures::all(SAMPLER_UNIFORM).build_options());
   }
   void check_accumulate(int npix, int wave, uint64_t base);
-  void check_generate(int4 window, uint32_t first_pass, uint32_t path_sampler);
+  void check_generate(int4 window, uint32_t first_pass, uint32_t path_sampler, RowBands bands = {});
   ClRuntime rt_;
   cl::Program program_;
 };
 
-// The whole film from pass 0, and a window of it from pass 17 (a crop of a sample range): the
-// film pixel and the pass of each path, and so its random numbers, are those of the full render.
+// The whole film from pass 0, and a window of it from pass 17 (a crop of a sample range), and
+// bands of rows of either: the film pixel and the pass of each path, and so its random numbers,
+// are those of the full render.
 TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
   for (int4 window : {make_int4(0, 0, 37, 23), make_int4(5, 3, 11, 7)}) {
     const uint32_t first_pass = window.z == 37 ? 0 : 17;
-    check_generate(window, first_pass, PATH_SAMPLER_INDEPENDENT);
-    check_generate(window, first_pass, PATH_SAMPLER_SOBOL);
+    for (uint32_t ps : {PATH_SAMPLER_INDEPENDENT, PATH_SAMPLER_SOBOL}) {
+      check_generate(window, first_pass, ps);
+      check_generate(window, first_pass, ps, RowBands{2, 3, 1, 2});
+      check_generate(window, first_pass, ps, RowBands{4, 2, 0, 1});
+    }
   }
 }
 
-void KernelUtilities::check_generate(int4 window, uint32_t first_pass, uint32_t path_sampler) {
-  SCOPED_TRACE(::testing::Message() << "path sampler " << path_sampler);
+// The rows that bands cover, counted and listed by cl/row_bands.h, against a direct enumeration.
+TEST(RowBands, CoveredRowsAreTheBandsInThePeriod) {
+  for (int height : {1, 3, 8})
+    for (int period : {1, 2, 3, 4})
+      for (int first = 0; first < period; ++first)
+        for (int count = 1; first + count <= period; ++count)
+          for (int rows : {1, 7, 8, 23, 24, 25, 216}) {
+            const RowBands b{height, period, first, count};
+            std::vector<uint32_t> want;
+            for (int y = 0; y < rows; ++y)
+              if ((y / height) % period >= first && (y / height) % period < first + count)
+                want.push_back(uint32_t(y));
+            ASSERT_EQ(covered_rows(b.packed(), rows), int(want.size()));
+            for (size_t r = 0; r < want.size(); ++r)
+              ASSERT_EQ(covered_row(b.packed(), uint32_t(r)), want[r]);
+          }
+}
+
+void KernelUtilities::check_generate(int4 window, uint32_t first_pass, uint32_t path_sampler,
+                                     RowBands bands) {
+  SCOPED_TRACE(::testing::Message()
+               << "path sampler " << path_sampler << " bands " << bands.height << " "
+               << bands.period << " " << bands.first << " " << bands.count);
+  window.w = covered_rows(bands.packed(), window.w); // the rows the render covers
   Camera cam;
   cam.position = make_float3(1, 2, 3);
   cam.look_at = make_float3(0, 0.5f, -1);
@@ -730,6 +758,7 @@ void KernelUtilities::check_generate(int4 window, uint32_t first_pass, uint32_t 
   args.set("seed", cl_uint(99));
   args.set("path_sampler", cl_uint(path_sampler));
   args.set("window", window);
+  args.set("bands", bands.packed());
   args.set("first_pass", cl_uint(first_pass));
   args.set("wave_base", cl_ulong(base));
   args.set("count", cl_int(n));
@@ -752,8 +781,15 @@ void KernelUtilities::check_generate(int4 window, uint32_t first_pass, uint32_t 
   for (int i = 0; i < n; ++i) {
     uint64_t g = base + uint64_t(i);
     uint32_t in_win = uint32_t(g % nwin), pass = first_pass + uint32_t(g / nwin);
-    uint32_t pixel =
-        uint32_t((window.y + int(in_win) / window.z) * w + window.x + int(in_win) % window.z);
+    // the covered row: the (in_win / width)-th window row whose band is in [first, first + count)
+    auto covered = [&](int y) {
+      const int band = (y / bands.height) % bands.period;
+      return band >= bands.first && band < bands.first + bands.count;
+    };
+    int row = 0;
+    for (int left = int(in_win) / window.z; !(covered(row) && left-- == 0);)
+      ++row;
+    uint32_t pixel = uint32_t((window.y + row) * w + window.x + int(in_win) % window.z);
     float2 j;
     uint4 state = path_sampler_start(path_sampler, 99, pixel, pass, &j);
     if (path_sampler == PATH_SAMPLER_INDEPENDENT) { // the PCG stream's first two numbers

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <tuple>
 
 using namespace canopy;
 
@@ -96,6 +97,25 @@ TEST(AutoSampler, TheExplorationFitsTheSampleBudget) {
 
 // Inverse-variance weights relative to the predicted choice, by the typical tile, at most 1; a
 // candidate that missed its tail weighs nothing and is not the reference.
+// The costly candidates explore one band of 8 rows in every 1 to 4, keeping at least 16,384 pixels
+// and a band in each of the film's 8 x 8 tiles.
+TEST(AutoSampler, TheExplorationCoversBandsThatKeepEnoughPixels) {
+  for (auto [w, h, period] :
+       {std::tuple{128, 96, 1}, std::tuple{288, 216, 3}, std::tuple{512, 512, 4},
+        std::tuple{1024, 128, 2}, std::tuple{4096, 16, 1}}) {
+    const RowBands b = exploration_bands(w, h);
+    EXPECT_EQ(b.period, period) << w << "x" << h;
+    EXPECT_EQ(b.height, kExploreBandRows);
+    EXPECT_EQ(b.first, 0);
+    EXPECT_EQ(b.count, 1);
+    if (period > 1) {
+      EXPECT_GE(w * covered_rows(b.packed(), h), kExploredPixels) << w << "x" << h;
+    }
+  }
+  EXPECT_EQ(exploration_bands(64, 48, 3).period, 3); // as asked
+  EXPECT_EQ(exploration_bands(64, 12, 3).period, 1); // too few rows for bands
+}
+
 TEST(AutoSampler, ExplorationWeightsAreInverseVarianceToTheChoiceAndDropAMissedTail) {
   std::vector<PilotResult> c(3);
   auto set = [&](size_t i, double v, double mean, double tile_v) {
@@ -206,12 +226,15 @@ TEST(AutoSampler, TheExplorationRanksByEfficiencyAndItsSamplesArePartOfTheImage)
 // The image made of the candidates' weighted exploration passes and the chosen one's samples is
 // unbiased: over 8 seeds its image mean equals the exhaustive estimator's within 5 standard errors
 // of the difference; under point lights alone, and with sphere lights in view (whose pixels weigh
-// every sample 1).
-class CombinedImage : public ::testing::TestWithParam<bool> {};
+// every sample 1), with the exploration on every row, on bands of them (one in three) for the
+// splitting candidate, and (at 5 spp, too few for two samples of each candidate per pixel) on
+// interleaved rows, a third of them each.
+class CombinedImage : public ::testing::TestWithParam<std::tuple<bool, int>> {};
 
 TEST_P(CombinedImage, IsUnbiased) {
   std::string json = kGridJson;
-  if (GetParam()) // emitters in view: their pixels' samples are weighted 1
+  const auto [emitters, period] = GetParam();
+  if (emitters) // emitters in view: their pixels' samples are weighted 1
     json.replace(json.find("\"light_sets\""), 12,
                  R"("lights": [ { "type": "sphere", "center": [1, 0.6, 0], "radius": 0.4,
                                   "radiance": [30, 30, 30] },
@@ -244,13 +267,25 @@ TEST_P(CombinedImage, IsUnbiased) {
   ref_var /= double(e.sum.size()) * double(e.sum.size());
 
   RendererOptions base = auto_candidates(RendererOptions{}).front().options;
+  // Waves of 256 paths for the splitting candidate: a pass over its bands (16 of 48 rows) fills
+  // one, so it explores on them; power and tree, whose waves hold 2^18 paths, on the film.
+  if (period > 1) base.split_queue_items = 1 << 14;
+  const bool interleaved = period == 0;
   Renderer renderer(rt, scene, base);
   std::vector<double> means;
   for (uint32_t seed = 1; seed <= 8; ++seed) {
-    rs.spp = 24;
+    rs.spp = interleaved ? 5 : 24;
     rs.seed = seed;
-    AutoRender r = render_auto(renderer, base, rs);
+    AutoRender r = render_auto(renderer, base, rs, period);
     ASSERT_FALSE(r.choice.candidates.empty());
+    if (interleaved) {
+      EXPECT_EQ(r.choice.explored_samples, 2);
+    }
+    for (size_t i = 0; i < 3; ++i)
+      EXPECT_DOUBLE_EQ(r.choice.candidates[i].explored_share,
+                       interleaved || (period > 1 && i == 2) ? 16.0 / 48.0 : 1.0);
+    for (const double4& x : r.film.sum) // every pixel, explored or not, has spp samples
+      ASSERT_EQ(x.w, double(rs.spp));
     means.push_back(image_mean(r.film));
   }
   double m = 0.0, v = 0.0;
@@ -264,9 +299,15 @@ TEST_P(CombinedImage, IsUnbiased) {
   EXPECT_GT(se, 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(AutoSampler, CombinedImage, ::testing::Values(false, true),
+INSTANTIATE_TEST_SUITE_P(AutoSampler, CombinedImage,
+                         ::testing::Combine(::testing::Bool(), ::testing::Values(1, 3, 0)),
                          [](const auto& p) {
-                           return std::string(p.param ? "EmittersInView" : "PointLights");
+                           const int mode = std::get<1>(p.param);
+                           return std::string(std::get<0>(p.param) ? "EmittersInView"
+                                                                   : "PointLights") +
+                                  (mode == 1   ? ""
+                                   : mode == 3 ? "OnBands"
+                                               : "OnInterleavedRows");
                          });
 
 // A scene built to defeat a ranking by few samples (as Veach's MIS scene): a tiny, very bright
@@ -322,17 +363,17 @@ TEST(AutoSampler, AHeavyTailSceneIsRankedCorrectly) {
   }
 }
 
-// Too few samples to explore: the last candidate renders it all, as a partial render would.
-TEST(AutoSampler, WithoutRoomToExploreTheLastCandidateRenders) {
+// Too few samples to explore (1 or 2 spp): tree renders it all, bit for bit its own render.
+TEST(AutoSampler, WithoutRoomToExploreTreeRenders) {
   AutoRun run(kGridJson);
-  AutoRender r = run.render(6, 3);
+  AutoRender r = run.render(kInterleavedMinSpp - 1, 3);
   const RendererOptions& base = run.base;
   EXPECT_TRUE(r.choice.candidates.empty());
-  EXPECT_EQ(r.choice.chosen.label, auto_candidates(base).back().label);
-  RendererOptions last = auto_candidates(base).back().options;
+  EXPECT_EQ(r.choice.chosen.label, "tree");
+  RendererOptions last = auto_candidates(base)[kFewSamplesCandidate].options;
   Renderer fresh(run.rt, run.scene, last);
   RenderSettings rs;
-  rs.spp = 6;
+  rs.spp = kInterleavedMinSpp - 1;
   rs.seed = 3;
   Film f = fresh.render(rs);
   for (size_t p = 0; p < f.sum.size(); ++p)

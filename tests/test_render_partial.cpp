@@ -152,6 +152,42 @@ TEST_P(PartialRender, TilesAndRangesMergeIntoTheFullRender) {
   EXPECT_EQ(missing.min_samples, 5u);
 }
 
+// A render of bands of the film's rows (in a window, over a sample range) equals the full render
+// on the rows it covers, and has no samples on the others.
+TEST_P(PartialRender, BandsOfRowsEqualTheFullRendersRows) {
+  RenderSettings rs;
+  rs.seed = 5;
+  rs.first_sample = 2;
+  rs.spp = 5;
+  rs.window = PixelWindow{3, 1, 29, 23};
+  rs.wave_size = 997;
+  const Film full = renderer_->render(rs);
+  rs.bands = RowBands{3, 4, 1, 2}; // rows 3-8 of every 12 of the window's 22
+  renderer_->reset_render_stats();
+  const Film part = renderer_->render(rs);
+  ASSERT_EQ(part.width, full.width);
+  ASSERT_EQ(part.height, full.height);
+  EXPECT_EQ(renderer_->stats().samples, uint64_t(rs.spp) * 26 * 12); // rows 3-8, 15-20
+  int covered = 0;
+  for (int y = 0; y < part.height; ++y) {
+    const bool in = (y / 3) % 4 == 1 || (y / 3) % 4 == 2;
+    covered += in;
+    for (int x = 0; x < part.width; ++x) {
+      const size_t p = size_t(y * part.width + x);
+      if (!in) {
+        ASSERT_EQ(part.sum[p].w, 0.0) << x << ", " << y;
+        continue;
+      }
+      ASSERT_EQ(part.sum[p].w, double(rs.spp));
+      for (double d : {part.sum[p].x - full.sum[p].x, part.sum[p].y - full.sum[p].y,
+                       part.sum[p].z - full.sum[p].z})
+        ASSERT_LE(std::fabs(d), 1e-5 * std::fabs(full.sum[p].x + full.sum[p].y + full.sum[p].z))
+            << x << ", " << y;
+    }
+  }
+  EXPECT_EQ(covered, 12);
+}
+
 INSTANTIATE_TEST_SUITE_P(Scenes, PartialRender,
                          ::testing::Combine(::testing::Values("glossy-cornell", "spiral-fog"),
                                             ::testing::Values("independent", "sobol")),

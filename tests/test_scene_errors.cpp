@@ -280,7 +280,8 @@ TEST(SceneErrors, DuplicateMaterialName) {
 TEST(SceneErrors, UnknownMaterialType) {
   EXPECT_EQ(error_of(scene_with(R"("materials": [{"name": "m", "type": "glass", "albedo": 1}])")),
             "scene.json: materials[0].type: unknown value \"glass\" (expected one of: diffuse, "
-            "conductor, plastic, dielectric, coated_diffuse, coated_conductor)");
+            "conductor, plastic, dielectric, coated_diffuse, coated_conductor, "
+            "diffuse_transmission, mix)");
 }
 
 TEST(SceneErrors, CoatedAndRoughGlassValues) {

@@ -374,10 +374,10 @@ TEST(ScenePbrt, ConductorRoughnessAndMetalPresets) {
 }
 
 TEST(ScenePbrt, UnknownMaterialAndTextureFallBackWithWarnings) {
-  Scene s = load(
-      std::string(kKeptCamera) + "WorldBegin\n" + "Texture \"t\" \"spectrum\" \"checkerboard\"\n" +
-      "Material \"hair\" \"float eta\" 1.5\n" + tri_at("0 0 0  1 0 0  0 1 0") +
-      "Material \"diffuse\" \"texture reflectance\" \"t\"\n" + tri_at("0 0 0  1 0 0  0 1 0"));
+  Scene s =
+      load(std::string(kKeptCamera) + "WorldBegin\n" + "Texture \"t\" \"spectrum\" \"dots\"\n" +
+           "Material \"hair\" \"float eta\" 1.5\n" + tri_at("0 0 0  1 0 0  0 1 0") +
+           "Material \"diffuse\" \"texture reflectance\" \"t\"\n" + tri_at("0 0 0  1 0 0  0 1 0"));
   // The unsupported texture class warns where it is defined, not again where it is used.
   ASSERT_EQ(s.warnings.size(), 2u);
   EXPECT_EQ(s.warnings[0].rfind("t.pbrt:5: ", 0), 0u) << s.warnings[0];

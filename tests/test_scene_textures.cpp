@@ -259,13 +259,13 @@ TEST(SceneTexturesPbrt, TexturesAreGlobalAcrossAttributes) {
 
 TEST(SceneTexturesPbrt, UnsupportedClassesWarnOnceAndKeepTheDefault) {
   const std::string text =
-      kHead + "Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 4\n" +
+      kHead + "Texture \"t\" \"spectrum\" \"dots\" \"float uscale\" 4\n" +
       "Texture \"f\" \"float\" \"fbm\"\n" +
       "Material \"coateddiffuse\" \"texture reflectance\" \"t\" \"texture roughness\" \"f\"\n" +
       kTri;
   Scene s = load(text);
   ASSERT_EQ(s.warnings.size(), 2u);
-  EXPECT_EQ(s.warnings[0], "t.pbrt:5: Texture \"t\": the texture class \"checkerboard\" is not "
+  EXPECT_EQ(s.warnings[0], "t.pbrt:5: Texture \"t\": the texture class \"dots\" is not "
                            "supported (a material using it keeps its constant default), ignored");
   EXPECT_EQ(s.warnings[1].rfind("t.pbrt:6: Texture \"f\": the texture class \"fbm\"", 0), 0u);
   EXPECT_TRUE(s.textures.empty());

@@ -28,7 +28,7 @@ INLINE int light_pick_shadow_item_u(const LightSamplerCtx* ls, const SceneBuffer
   if (!(pmf > 0.0f)) return 0;
   LightPoint lp;
   if (HAS_LIGHT_ENVIRONMENT && IS_LIGHT(&ls->lights[light], LIGHT_ENVIRONMENT)) {
-    LightSample s = env_light_sample(ls, &ls->lights[light], light_query_normal(pb, path),
+    LightSample s = env_light_sample(ls, &ls->lights[light], env_query_normal(pb, path),
                                      xyz_of(pb->shade_P[path]), rng);
     if (!light_point_from(sc, pb, path, s, &lp)) return 0;
   } else {

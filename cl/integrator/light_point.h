@@ -27,13 +27,27 @@ INLINE int light_point_from(const SceneBuffers* sc, const PathBuffers* pb, int p
                             LightPoint* lp) {
   float3 P = xyz_of(pb->shade_P[path]);
   float3 N = xyz_of(pb->shade_N[path]);
-  // Light arriving from below the geometric surface would leak through it (shading normals).
-  if (!(s.pdf > 0.0f) || !(dot(N, s.wi) > 0.0f) || !(max3(s.Li) > 0.0f)) return 0;
+  // Light arriving from below the geometric surface would leak through it (shading normals),
+  // except at a point that transmits: there it arrives from either side, and a direction must be
+  // on the same side of the geometric and of the shading surface.
+  const int two_sided = shading_point_two_sided(pb, path);
+  float side = dot(N, s.wi);
+  if (!(s.pdf > 0.0f) || !(two_sided ? side != 0.0f : side > 0.0f) || !(max3(s.Li) > 0.0f))
+    return 0;
   Material m = shading_point_material(sc, pb, path);
   float3 Ns = xyz_of(pb->shade_Ns[path]);
   float cos_s = dot(Ns, s.wi); // = the local frame's wi.z
-  if (!(cos_s > 0.0f)) return 0;
-  if (!HAS_GGX || m.type == MATERIAL_DIFFUSE) {
+  if (!(two_sided ? cos_s * side > 0.0f : cos_s > 0.0f)) return 0;
+  if (two_sided && side < 0.0f) { // leaves from the far side (shade_surface's offset origin)
+    P = xyz_of(pb->shade_back[path]);
+    cos_s = -cos_s;
+  }
+#if HAS_GGX || HAS_MATERIAL_DIFFUSE_TRANSMISSION
+  const int lambertian = m.type == MATERIAL_DIFFUSE;
+#else
+  const int lambertian = 1;
+#endif
+  if (lambertian) {
     // Lambertian needs no frame (the common case, and the only one of a diffuse-only kernel).
     lp->f_cos =
         diffuse_eval(&m, make_float3(0.0f, 0.0f, 1.0f), make_float3(0.0f, 0.0f, cos_s)) * cos_s;
@@ -42,7 +56,7 @@ INLINE int light_point_from(const SceneBuffers* sc, const PathBuffers* pb, int p
     Frame fr = frame_from(Ns);
     float3 wo = frame_to_local(&fr, xyz_of(pb->shade_wo[path]));
     float3 wi = frame_to_local(&fr, s.wi);
-    lp->f_cos = bsdf_eval(&m, wo, wi) * cos_s;
+    lp->f_cos = bsdf_eval(&m, wo, wi) * cos_s; // (cos_s = |wi.z|)
     lp->bsdf_pdf = bsdf_pdf(&m, wo, wi);
   }
   if (s.is_delta) lp->bsdf_pdf = 0.0f;           // BSDF sampling never finds a point light

@@ -41,6 +41,12 @@
   /* With image textures: the textured material's albedo (xyz) and alpha (w) at the shading */     \
   /* point (shading_point_material), written only where its material has a texture */              \
   X(float4, shade_tex)                                                                             \
+  /* With a diffuse-transmission material's transmittance texture: its value there (xyz) */       \
+  X(float4, shade_tex_t)                                                                           \
+  /* With diffuse transmission (HAS_MATERIAL_DIFFUSE_TRANSMISSION): xyz: the origin of rays */    \
+  /* leaving the shading point on the far side of the surface, w: 1 if light reaches the point */ \
+  /* from both sides (bsdf_two_sided), else 0 */                                                  \
+  X(float4, shade_back)                                                                            \
   /* brdf-mis, brdf-oriented (brdf_mis.h): x: cut size, y: BRDF-aware samples N (-1: a glossy */   \
   /* point whose cut is not built yet), z: samples drawn, w: n_hit | n_nohit << 16 (Alg. 1) */     \
   X(int4, brdf_state)                                                                              \
@@ -96,12 +102,30 @@ typedef struct SceneBuffers {
 // conservative: a direction below the shading horizon contributes nothing, and one below the
 // geometric surface is rejected besides (as pbrt-v4's LightSampleContext, which carries ns).
 // shade_surface, light_pick and the BRDF-oriented cut all read it here, so their pmfs agree.
+// At a point that light reaches from both sides (diffuse transmission) the queries carry no normal
+// (N = 0, no receiver term): a one-sided bound would cull the lights behind the surface.
 INLINE float3 light_query_normal(const PathBuffers* pb, int path) {
+  if (HAS_MATERIAL_DIFFUSE_TRANSMISSION ? pb->shade_back[path].w != 0.0f : 0)
+    return make_float3(0.0f, 0.0f, 0.0f);
   return xyz_of(pb->shade_Ns[path]);
 }
 
-// The material at the path's shading point: the scene's material, with the textured albedo and
-// alpha that shade_surface looked up at the hit (cl/texture.h) where it has textures.
+// The normal environment lights are sampled about at the shading point (a constant sky by the
+// cosine, cl/lights/environment.h): the shading normal, on both kinds of point. At a two-sided
+// point such a sky is then sampled on wo's side only; its pdf is 0 beyond, where BSDF rays that
+// escape take weight 1 (shade_environment_weight).
+INLINE float3 env_query_normal(const PathBuffers* pb, int path) {
+  return xyz_of(pb->shade_Ns[path]);
+}
+
+// Whether the shading point of `path` takes light from both sides of its surface.
+INLINE int shading_point_two_sided(const PathBuffers* pb, int path) {
+  return HAS_MATERIAL_DIFFUSE_TRANSMISSION ? pb->shade_back[path].w != 0.0f : 0;
+}
+
+// The material at the path's shading point: the scene's material (a mix already resolved to the
+// one chosen there, cl/material_mix.h), with the textured albedo, alpha and transmittance that
+// shade_surface looked up at the hit (cl/texture.h) where it has textures.
 INLINE Material shading_point_material(const SceneBuffers* sc, const PathBuffers* pb, int path) {
   Material m = sc->materials[(int)float_as_uint_(pb->shade_Ns[path].w)];
   if (HAS_TEXTURES ? (m.albedo_texture | m.alpha_texture) != 0 : 0) {
@@ -109,6 +133,9 @@ INLINE Material shading_point_material(const SceneBuffers* sc, const PathBuffers
     m.albedo = f4_from3(xyz_of(t), 0.0f);
     m.alpha = t.w;
   }
+#if HAS_TEXTURES && HAS_MATERIAL_DIFFUSE_TRANSMISSION
+  if (m.transmittance_texture != 0) m.specular = f4_from3(xyz_of(pb->shade_tex_t[path]), 0.0f);
+#endif
   return m;
 }
 

@@ -20,6 +20,7 @@
 #include "../bsdf/bsdf.h"
 #include "../geometry.h"
 #include "../lights/light_sample.h"
+#include "../material_mix.h"
 #include "../sampler.h"
 #include "../shading.h"
 #include "../texture.h"
@@ -54,7 +55,7 @@ INLINE float shade_environment_weight(const LightSamplerCtx* ls, const PathBuffe
   float4 prev_P = pb->shade_P[path];
   if (depth == 0 || !(prev_P.w > 0.0f) || ls->kind == SAMPLER_BSDF) return 1.0f;
   if (!CANOPY_MIS) return 0.0f; // light sampling alone accounts for it
-  return power_heuristic(prev_P.w, env_pdf(l, &ls->env, light_query_normal(pb, path), d));
+  return power_heuristic(prev_P.w, env_pdf(l, &ls->env, env_query_normal(pb, path), d));
 }
 
 INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBuffers* sc,
@@ -107,14 +108,30 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
     return out;
   }
 
-  Material m = sc->materials[prim->material];
+  // A mix is the material it chooses here (the same for every later use of this point).
+  const int mat = HAS_MATERIAL_MIX ? material_resolve_mix(sc->materials, prim->material, P_hit, wo,
+                                                          sc->texcoords, sc->textures, sc->texels,
+                                                          h.prim, h.u, h.v)
+                                   : prim->material;
+  Material m = sc->materials[mat];
+  // Whether the surface bounds a medium-free inside belongs to the surface (its own material),
+  // not to the material a mix chose.
+  if (HAS_MATERIAL_MIX ? mat != prim->material : 0)
+    m.excludes_medium = sc->materials[prim->material].excludes_medium;
   material_face(&m, dot(Ng, d) > 0.0f); // a ray from inside glass sees the inverse index
-  if (HAS_TEXTURES ? (m.albedo_texture | m.alpha_texture) != 0 : 0) {
-    // The textured albedo and alpha at the hit, kept for light_pick and brdf_mis
+  if (HAS_TEXTURES ? (m.albedo_texture | m.alpha_texture | m.transmittance_texture) != 0 : 0) {
+    // The textured albedo, alpha and transmittance at the hit, kept for light_pick and brdf_mis
     // (shading_point_material).
     material_apply_textures(&m, sc->texcoords, sc->textures, sc->texels, h.prim, h.u, h.v);
     pb->shade_tex[path] = f4_from3(xyz_of(m.albedo), m.alpha);
+    if (HAS_MATERIAL_DIFFUSE_TRANSMISSION ? m.transmittance_texture != 0 : 0)
+      pb->shade_tex_t[path] = f4_from3(xyz_of(m.specular), 0.0f);
   }
+  // Light reaches a transmitting point from both sides: rays towards the far side leave from
+  // an origin offset to that side (light_point.h), and its light-tree queries take no normal.
+  const int two_sided = bsdf_two_sided(&m);
+  if (HAS_MATERIAL_DIFFUSE_TRANSMISSION)
+    pb->shade_back[path] = f4_from3(offset_ray_origin(P_hit, P_err, -N), two_sided ? 1.0f : 0.0f);
   // The vertex's numbers (cl/sampler.h): the light samplers' seed, the BSDF direction, Russian
   // roulette, the lobe choice.
   uint4 ps = pb->rng[path];
@@ -165,7 +182,7 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   const float outside_medium =
       m.excludes_medium ? (dot(Ng, d) > 0.0f ? 1.0f : 0.0f) : pb->ray_d[path].w;
   pb->shade_wo[path] = f4_from3(wo, outside_medium);
-  pb->shade_Ns[path] = f4_from3(Ns, uint_as_float_((uint)prim->material));
+  pb->shade_Ns[path] = f4_from3(Ns, uint_as_float_((uint)mat));
   pb->shade_P[path] = f4_from3(P, 0.0f);
   if (black) return out;
 
@@ -186,8 +203,9 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   if (!(max3(beta) > 0.0f) || !(bs.is_delta || bs.pdf > 0.0f)) return out;
   // 0: emission this ray finds gets full weight. Through rough glass as after a delta bounce: light
   // samples are taken on wo's side only (light_point.h rejects the far side), so the light
-  // technique cannot produce a path through the surface.
-  pb->shade_P[path] = f4_from3(P, bs.is_delta || through ? 0.0f : bs.pdf);
+  // technique cannot produce a path through the surface. A two-sided point samples lights on both
+  // sides, so its transmitted rays are weighted as its reflected ones.
+  pb->shade_P[path] = f4_from3(P, bs.is_delta || (through && !two_sided) ? 0.0f : bs.pdf);
   pb->ray_o[path] = f4_from3(through ? offset_ray_origin(P_hit, P_err, -N) : P, 0.0f);
   // Leaving a surface that bounds a medium-free inside, a ray takes the medium of its side (into
   // the inside: none); elsewhere it keeps the one it had.

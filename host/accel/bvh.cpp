@@ -314,9 +314,8 @@ SceneGeometry build_scene_geometry(Scene& scene, std::vector<Material>& material
   g.shading_normals.reserve(scene.shading_normals.size());
   for (const float3& n : scene.shading_normals)
     g.shading_normals.push_back(f4_from3(n, 0.0f));
-  const bool textured = std::any_of(materials.begin(), materials.end(), [](const Material& m) {
-    return m.albedo_texture > 0 || m.alpha_texture > 0;
-  });
+  const bool textured = std::any_of(materials.begin(), materials.end(),
+                                    [](const Material& m) { return material_textured(m); });
   if (textured && !scene.triangle_uvs.empty()) {
     g.texcoords = scene.triangle_uvs;
   } else if (textured) {

@@ -87,7 +87,8 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   size_t clear = 0;
   bool any_clear = false;
   for (size_t p = 0; p < film.sum.size(); ++p)
-    any_clear = any_clear || ((half < 0 || half_of(film, p) == half) && !emitter[p]);
+    any_clear =
+        any_clear || ((half < 0 || half_of(film, p) == half) && !emitter[p] && film.sum[p].w > 1.0);
   for (size_t p = 0; p < film.sum.size(); ++p) {
     if (half >= 0 && half_of(film, p) != half) continue;
     const double k = film.sum[p].w;
@@ -128,7 +129,8 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   const double top = std::accumulate(v.begin(), v.begin() + std::ptrdiff_t(worst), 0.0);
   st.tail_share = total > 0.0 ? top / total : 0.0;
   for (size_t t = 0; t < tile_sum.size(); ++t)
-    if (tile_n[t] > 0.0) st.tile_variance.push_back(tile_sum[t] / n);
+    st.tile_variance.push_back(tile_n[t] > 0.0 ? tile_sum[t] / n
+                                               : std::numeric_limits<double>::quiet_NaN());
   if (clear > 0) {
     st.mean = mean / double(clear);
     st.mean_variance = mean_var / (double(clear) * double(clear));
@@ -160,14 +162,15 @@ std::vector<bool> missed_tails(const std::vector<ExploreStats>& s) {
 // its variance for every candidate, and that spread cancels).
 bool significantly_less(const ExploreStats& a, double ka, const ExploreStats& b, double kb) {
   const std::vector<double>&ta = a.tile_variance, &tb = b.tile_variance;
-  const double diff = b.variance * kb - a.variance * ka;
-  if (ta.size() != tb.size() || ta.size() < 2) return diff > 0.0;
-  const double tiles = double(ta.size());
+  std::vector<double> d; // per tile both measured
+  for (size_t t = 0; t < std::min(ta.size(), tb.size()); ++t)
+    if (std::isfinite(ta[t]) && std::isfinite(tb[t])) d.push_back(tb[t] * kb - ta[t] * ka);
+  if (d.size() < 2 || ta.size() != tb.size()) return b.variance * kb - a.variance * ka > 0.0;
+  const double tiles = double(d.size());
+  const double diff = std::accumulate(d.begin(), d.end(), 0.0);
   double dev = 0.0;
-  for (size_t t = 0; t < ta.size(); ++t) {
-    const double d = tb[t] * kb - ta[t] * ka - diff / tiles;
-    dev += d * d;
-  }
+  for (double x : d)
+    dev += (x - diff / tiles) * (x - diff / tiles);
   return diff > 1.96 * std::sqrt(tiles / (tiles - 1.0) * dev);
 }
 
@@ -229,7 +232,8 @@ std::vector<double> exploration_weights(std::vector<PilotResult> other) {
     const ExploreStats &si = other[i].stats, &sr = other[ref].stats;
     std::vector<double> ratio;
     for (size_t t = 0; t < std::min(si.tile_variance.size(), sr.tile_variance.size()); ++t)
-      if (sr.tile_variance[t] > 0.0) ratio.push_back(si.tile_variance[t] / sr.tile_variance[t]);
+      if (sr.tile_variance[t] > 0.0 && std::isfinite(si.tile_variance[t]))
+        ratio.push_back(si.tile_variance[t] / sr.tile_variance[t]);
     double excess = sr.variance > 0.0 ? si.variance / sr.variance : 1.0;
     if (!ratio.empty()) {
       std::nth_element(ratio.begin(), ratio.begin() + std::ptrdiff_t(ratio.size() / 2),
@@ -241,35 +245,69 @@ std::vector<double> exploration_weights(std::vector<PilotResult> other) {
   return w;
 }
 
+RowBands exploration_bands(int width, int height, int period) {
+  if (period <= 0) // as many as keep kExploredPixels or more, and a band in every tile
+    period =
+        std::min(std::clamp(int(double(width) * double(height) / double(kExploredPixels)), 1, 4),
+                 std::max(1, height / (kTiles * kExploreBandRows)));
+  RowBands b;
+  b.height = kExploreBandRows;
+  b.period = std::min(period, std::max(1, height / kExploreBandRows));
+  return b;
+}
+
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
-                       const RenderSettings& settings) {
+                       const RenderSettings& settings, int explore_period) {
   const auto t0 = Clock::now();
   AutoRender out;
   AutoChoice& choice = out.choice;
   std::vector<PilotResult> cand = auto_candidates(base);
   const int fw = renderer.scene().film.width, fh = renderer.scene().film.height;
-  const double npix = double(fw) * double(fh);
+  const RowBands bands = exploration_bands(fw, fh, explore_period);
+  const double film_pixels = double(fw) * double(fh);
+  const double band_pixels = double(fw) * double(covered_rows(bands.packed(), fh));
   std::vector<int> wave_passes;
-  for (const PilotResult& c : cand) {
+  for (PilotResult& c : cand) {
     // The passes that fill one of the sampler's waves (2^18 paths: 4 passes of a 256x256 film;
     // a splitting sampler's about split_queue_items / max_cut, 16,384: 1 pass; the renderer's
-    // paths_per_wave also counts a medium segment's cut and the distant lights). A render of the
-    // film itself, of at least one wave, has the render's own wave structure (docs/design.md,
-    // "Choosing the estimator per scene").
+    // paths_per_wave also counts a medium segment's cut and the distant lights). A render of at
+    // least one wave has the render's own wave structure (docs/design.md, "Choosing the estimator
+    // per scene"): a candidate explores on bands of rows only if a pass over them still fills
+    // one of its waves (the costly splitting samplers, whose waves are small), else on the film.
     const RendererOptions& o = c.options;
     const bool splits = o.light_sampler != "power" && o.light_sampler != "tree";
     const double wave = splits ? double(o.split_queue_items) / double(std::max(1, o.max_cut))
                                : double(settings.wave_size);
+    if (!bands.all() && wave <= band_pixels) c.bands = bands;
+    const double npix = c.bands.all() ? film_pixels : band_pixels;
+    c.explored_share = npix / film_pixels;
     wave_passes.push_back(int(std::clamp(std::ceil(wave / npix), 1.0, 256.0)));
   }
   int renders = 0;
-  const std::vector<int> passes = settings.window.empty()
-                                      ? plan_exploration(settings.spp, wave_passes, &renders)
-                                      : std::vector<int>();
+  std::vector<int> passes = settings.window.empty()
+                                ? plan_exploration(settings.spp, wave_passes, &renders)
+                                : std::vector<int>();
+  // Too few samples for every candidate to render two in each pixel: each renders two on its
+  // own interleaved rows (every n-th row), the chosen one the rest of every pixel.
+  const int n = int(cand.size());
+  const bool interleaved =
+      passes.empty() && settings.window.empty() && settings.spp >= kInterleavedMinSpp && fh >= n;
+  if (interleaved) {
+    passes.assign(cand.size(), 1);
+    renders = 1;
+    for (int i = 0; i < n; ++i) {
+      cand[size_t(i)].bands = RowBands{1, n, i, 1};
+      cand[size_t(i)].explored_share =
+          double(covered_rows(cand[size_t(i)].bands.packed(), fh)) / double(fh);
+    }
+  }
   RenderSettings rs = settings;
   rs.progress = nullptr;
-  if (passes.empty()) { // no room to explore: the last candidate, as a partial render takes
-    choice.chosen = cand.back();
+  if (passes.empty()) {
+    // No room to explore. A window is a partial render: the last candidate, as `canopy render
+    // --crop` takes, so that partial renders merge. 1 or 2 spp: the cheap `tree`; a preview that
+    // short cannot afford the costly candidate's samples (3 s for one on glossy-cornell).
+    choice.chosen = settings.window.empty() ? cand[kFewSamplesCandidate] : cand.back();
     choice.reason = "too few samples to explore";
     if (!same_sampler(renderer.options(), choice.chosen.options))
       renderer.set_light_sampler(choice.chosen.options);
@@ -286,6 +324,8 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   for (size_t i = 0; i < cand.size(); ++i) {
     PilotResult& c = cand[i];
     if (!same_sampler(renderer.options(), c.options)) renderer.set_light_sampler(c.options);
+    rs.bands = c.bands;
+    if (interleaved) next = settings.first_sample; // the same indices, on other rows
     c.first_sample = next;
     rs.first_sample = next;
     rs.spp = 1;
@@ -297,7 +337,8 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       const auto start = Clock::now();
       Film f = renderer.render(rs);
       const double t = std::chrono::duration<double>(Clock::now() - start).count();
-      c.pass_seconds = r == 0 ? t / passes[i] : std::min(c.pass_seconds, t / passes[i]);
+      const double per_pass = t / passes[i] / c.explored_share; // a pass over the whole film
+      c.pass_seconds = r == 0 ? per_pass : std::min(c.pass_seconds, per_pass);
       c.seconds += t;
       add_samples(film, f);
       next += passes[i];
@@ -335,12 +376,23 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     renderer.set_light_sampler(cand[best].options);
   choice.pilot_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
-  // The chosen candidate renders the rest; its samples share what is left of each pixel's mass:
-  // (spp - sum of the exploration's weighted samples) / (its samples), at least 1 each.
+  // The chosen candidate renders the rest: the samples after the exploration's everywhere, and
+  // the samples of a candidate that explored on bands of rows on the other rows. Its samples share
+  // what is left of each pixel's mass: (spp - sum of the exploration's weighted samples) / (its
+  // samples), at least 1 each.
   rs = settings;
   rs.first_sample = next;
   rs.spp = settings.first_sample + settings.spp - next;
   Film rest = renderer.render(rs);
+  for (const PilotResult& c : cand) {
+    if (c.bands.all() || interleaved) continue; // interleaved: the candidates cover every row
+    rs.first_sample = c.first_sample;
+    rs.spp = c.samples;
+    rs.bands = c.bands;
+    rs.bands.first = c.bands.first + c.bands.count; // the other bands of the period
+    rs.bands.count = c.bands.period - c.bands.count;
+    add_samples(rest, renderer.render(rs));
+  }
   // A candidate's weight at a pixel: 1 where another candidate's camera rays saw an emitter there
   // (that pixel's noise is mostly the emitter's edge, the same for every candidate, and unequal
   // weights on equally good samples add variance), unless it missed its tail; else its weight in
@@ -355,10 +407,10 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
         edge = edge || (d != i && films[d].counts[p].z > 0.0);
       const double wh = cand[i].weight[half_of(rest, p)];
       wc[i][p] = edge && wh > 0.0 ? 1.0 : wh; // a missed tail weighs nothing anywhere
-      w[p] -= wc[i][p] * double(cand[i].samples);
+      w[p] -= wc[i][p] * films[i].sum[p].w;   // its samples at p: 0 off the explored rows
     }
-  for (double& x : w)
-    x /= double(rs.spp);
+  for (size_t p = 0; p < npixels; ++p)
+    w[p] /= rest.sum[p].w;
   out.film = std::move(rest);
   for (size_t p = 0; p < w.size(); ++p) {
     double4 &x = out.film.sum[p], &q = out.film.sumsq[p];
@@ -379,9 +431,10 @@ std::string describe(const AutoChoice& choice) {
   for (size_t i = 0; i < choice.candidates.size(); ++i) {
     const PilotResult& c = choice.candidates[i];
     s += fmt::format(
-        "{} {} {:.4g} [{:.3g}, {:.3g}] ({:.3g} s/pass, tail {:.2f}, weight {:.2g}/{:.2g}){}",
+        "{} {} {:.4g} [{:.3g}, {:.3g}] ({:.3g} s/pass, {:.0f}% of the film, tail {:.2f}, weight "
+        "{:.2g}/{:.2g}){}",
         i ? "," : "", c.label, c.efficiency, c.efficiency_lo, c.efficiency_hi, c.pass_seconds,
-        c.stats.tail_share, c.weight[0], c.weight[1],
+        100.0 * c.explored_share, c.stats.tail_share, c.weight[0], c.weight[1],
         c.missed_tail ? " (missed its tail: not ranked)" : "");
   }
   return s + ")";

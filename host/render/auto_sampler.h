@@ -1,5 +1,6 @@
-// The "auto" light sampler: the render explores every candidate estimator on the film, then the
-// most efficient one renders the rest, and every sample of the exploration is part of the image.
+// The "auto" light sampler: the render explores every candidate estimator on the film (the costly
+// ones on bands of its rows), then the most efficient one renders the rest, and every sample of the
+// exploration is part of the image.
 // No single estimator is within 10% of the best on every shipped scene (docs/results.md): plain
 // `tree` wins where a point's important lights are few, splitting where they are many, `power`
 // where the tree's pick costs more than it buys. The exploration measures which case a scene is.
@@ -30,7 +31,8 @@ struct ExploreStats {
   // variance (the missed-tail test).
   double mean = 0.0, mean_variance = 0.0;
   // Per tile of the film (8 x 8): the sum of its pixels' variances, divided by the pixel count
-  // (so they add up to `variance`). Candidates are compared tile by tile: a tile's variance
+  // (so they add up to `variance`); NaN for a tile without measured pixels (of the other half, or
+  // off the candidate's bands of rows). Candidates are compared tile by tile: a tile's variance
   // depends mostly on what the tile shows, the same for every candidate.
   std::vector<double> tile_variance;
 };
@@ -44,6 +46,8 @@ struct PilotResult {
   std::string label; // the candidate, as `canopy converge` names it (e.g. brdf-mis/split=0.25)
   RendererOptions options;
   int first_sample = 0, samples = 0; // the sample indices it rendered in the exploration
+  RowBands bands;                    // on these rows (exploration_bands), or all
+  double explored_share = 1.0;       // of the film's pixels
   ExploreStats stats;                // over the film
   double seconds = 0.0;              // of its timed exploration renders
   double pass_seconds = 0.0;         // a sample pass over the film, timed in the exploration
@@ -72,9 +76,10 @@ struct AutoRender {
 
 // The candidates for `base` (whose light sampler is ignored): power, tree, and brdf-mis with
 // splitting at the renderer's default threshold (it renders as tree-split on a scene without a
-// glossy material); each keeps base's other settings. The last is the one taken without
-// exploration.
+// glossy material); each keeps base's other settings. The last is the one a partial render
+// (`--samples`, `--crop`) takes without exploring; kFewSamplesCandidate renders 1 or 2 spp.
 std::vector<PilotResult> auto_candidates(const RendererOptions& base);
+constexpr size_t kFewSamplesCandidate = 1; // tree
 
 // How many passes each candidate's two timed exploration renders hold, for a render of `spp`
 // samples per pixel: `wave_passes` (one per candidate) fills one of its waves. A candidate renders
@@ -105,12 +110,29 @@ size_t choose_candidate(std::vector<PilotResult>& candidates, std::string* reaso
 // variance.
 std::vector<double> exploration_weights(std::vector<PilotResult> other);
 
+// A candidate whose waves are small (a splitting sampler's) explores bands of kExploreBandRows
+// rows, one in every `period` (RowBands), so that the cost of its exploration does not grow with
+// the film, while its measurements keep at least kExploredPixels pixels (a ranking from fewer chose
+// wrong on the heavy-tail test scene) and a pass over the bands fills one of its waves (a pass
+// that does not weighs the per-wave costs more than the render does). `period` <= 0: the most of
+// 1 to 4 that keeps that many pixels and a band in every tile of the film's 8 x 8.
+constexpr int kExploreBandRows = 8;
+// Below the room for two samples per candidate in every pixel (plan_exploration), down to this
+// many samples per pixel, each candidate renders two samples on its own interleaved rows (every
+// third row: the rows of all candidates show the same image) and the chosen one the rest.
+constexpr int kInterleavedMinSpp = 3;
+constexpr int kExploredPixels = 16384;
+RowBands exploration_bands(int width, int height, int period = 0);
+
 // Renders samples [settings.first_sample, + settings.spp) of the whole film with the chosen
-// candidate after exploring all (see the file comment); the film's sums are weighted so that its
-// mean is the unbiased image and its count per pixel is spp. Leaves `renderer` set to the chosen
-// candidate. Without room to explore (plan_exploration), the last candidate renders it all.
+// candidate after exploring all, some on bands of rows (exploration_bands(film, explore_period);
+// see the file comment); the film's sums are weighted so that its mean is the
+// unbiased image and its count per pixel is spp. Leaves `renderer` set to the chosen candidate.
+// With too few samples to explore on every pixel (plan_exploration), down to kInterleavedMinSpp,
+// the candidates explore on interleaved rows; below that kFewSamplesCandidate renders it all, and
+// in a window the last candidate.
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
-                       const RenderSettings& settings);
+                       const RenderSettings& settings, int explore_period = 0);
 
 // One line for logs: "auto: tree (exploration 3 of 16 spp in 0.84 s; efficiency power 12.3 (0.05
 // s/pass, weight 0.1), ...)".

@@ -27,6 +27,7 @@ KernelFeatures KernelFeatures::all(int light_sampler) {
   f.light_disk = f.light_distant = f.light_environment = true;
   f.prim_sphere = f.prim_disk = true;
   f.material_conductor = f.material_plastic = f.material_dielectric = f.material_coated = true;
+  f.material_mix = f.material_diffuse_transmission = true;
   f.medium = true;
   f.textures = true;
   f.light_sampler = light_sampler;
@@ -40,14 +41,14 @@ std::string KernelFeatures::build_options() const {
       "-DHAS_LIGHT_DISK={} -DHAS_LIGHT_DISTANT={} -DHAS_LIGHT_ENVIRONMENT={} "
       "-DHAS_PRIM_SPHERE={} -DHAS_PRIM_DISK={} "
       "-DHAS_MATERIAL_CONDUCTOR={} -DHAS_MATERIAL_PLASTIC={} -DHAS_MATERIAL_DIELECTRIC={} "
-      "-DHAS_MATERIAL_COATED={} "
+      "-DHAS_MATERIAL_COATED={} -DHAS_MATERIAL_MIX={} -DHAS_MATERIAL_DIFFUSE_TRANSMISSION={} "
       "-DHAS_MEDIUM={} -DHAS_TEXTURES={} "
       "-DCANOPY_LIGHT_SAMPLER={} -DCANOPY_MIS={} -DCANOPY_VOLUME_MIDPOINT={}",
       int(light_point), int(light_spot), int(light_sphere), int(light_quad), int(light_triangle),
       int(light_disk), int(light_distant), int(light_environment), int(prim_sphere), int(prim_disk),
       int(material_conductor), int(material_plastic), int(material_dielectric),
-      int(material_coated), int(medium), int(textures), light_sampler, int(mis),
-      int(volume_midpoint));
+      int(material_coated), int(material_mix), int(material_diffuse_transmission), int(medium),
+      int(textures), light_sampler, int(mis), int(volume_midpoint));
 }
 
 KernelFeatures scene_features(const Scene& scene, int light_sampler) {
@@ -90,7 +91,9 @@ KernelFeatures scene_features(const Scene& scene, int light_sampler) {
         m.gpu.type == MATERIAL_DIELECTRIC || m.gpu.type == MATERIAL_THIN_DIELECTRIC;
     f.material_coated |=
         m.gpu.type == MATERIAL_COATED_DIFFUSE || m.gpu.type == MATERIAL_COATED_CONDUCTOR;
-    f.textures |= m.gpu.albedo_texture > 0 || m.gpu.alpha_texture > 0;
+    f.material_mix |= m.gpu.type == MATERIAL_MIX;
+    f.material_diffuse_transmission |= m.gpu.type == MATERIAL_DIFFUSE_TRANSMISSION;
+    f.textures |= material_textured(m.gpu);
   }
   return f;
 }

@@ -14,11 +14,13 @@ struct KernelFeatures {
   bool prim_sphere = false, prim_disk = false;
   bool material_conductor = false, material_plastic = false, material_dielectric = false;
   bool material_coated = false; // coated diffuse and coated conductor (cl/bsdf/layered.h)
-  bool medium = false;          // a participating medium (cl/volume/, shade_volume)
-  bool textures = false;        // a material with an image texture (cl/texture.h)
-  bool volume_midpoint = false; // medium segments ranked at their midpoint (ablation)
-  int light_sampler = 0;        // SAMPLER_* (cl/types.h)
-  bool mis = true;              // RendererOptions::mis
+  bool material_mix = false;    // a mix of two materials (cl/material_mix.h)
+  bool material_diffuse_transmission = false; // cl/bsdf/diffuse_transmission.h
+  bool medium = false;                        // a participating medium (cl/volume/, shade_volume)
+  bool textures = false;                      // a material with a texture (cl/texture.h)
+  bool volume_midpoint = false;               // medium segments ranked at their midpoint (ablation)
+  int light_sampler = 0;                      // SAMPLER_* (cl/types.h)
+  bool mis = true;                            // RendererOptions::mis
 
   // Everything on (for the test that checks specialisation changes nothing).
   static KernelFeatures all(int light_sampler);

@@ -74,6 +74,27 @@ float resolve_channel(double sum, double n, bool* beyond) {
   return float(x);
 }
 
+// A render of bands of the window's rows, its rows packed, spread over the window's `rows` rows;
+// the rows it did not cover have no samples.
+Film spread_rows(Film packed, const RowBands& bands, int rows) {
+  Film film = packed;
+  film.height = rows;
+  const size_t n = size_t(film.width) * size_t(rows);
+  film.sum.assign(n, double4{});
+  film.sumsq.assign(n, double4{});
+  film.counts.assign(n, double4{});
+  for (int r = 0; r < packed.height; ++r) {
+    const size_t from = size_t(r) * size_t(film.width);
+    const size_t to = size_t(covered_row(bands.packed(), uint(r))) * size_t(film.width);
+    for (size_t x = 0; x < size_t(film.width); ++x) {
+      film.sum[to + x] = packed.sum[from + x];
+      film.sumsq[to + x] = packed.sumsq[from + x];
+      film.counts[to + x] = packed.counts[from + x];
+    }
+  }
+  return film;
+}
+
 } // namespace
 
 RgbImage Film::mean() const {
@@ -283,7 +304,18 @@ Film Renderer::render(const RenderSettings& settings) {
     throw std::invalid_argument(
         fmt::format("render samples [{}, {}) are outside [0, {}]", settings.first_sample,
                     int64_t(settings.first_sample) + settings.spp, kMaxSpp));
-  const int width = win.width(), height = win.height();
+  const RowBands& bands = settings.bands;
+  if (bands.height < 1 || bands.period < 1 || bands.first < 0 || bands.count < 1 ||
+      bands.first + bands.count > bands.period)
+    throw std::invalid_argument(fmt::format("render row bands (height {}, period {}, bands [{}, "
+                                            "{})) are not a subset of the period",
+                                            bands.height, bands.period, bands.first,
+                                            bands.first + bands.count));
+  // The render's pixels: the window's rows that the bands cover, packed (generate.cl).
+  const int width = win.width(), height = covered_rows(bands.packed(), win.height());
+  if (height == 0)
+    throw std::invalid_argument(
+        fmt::format("render row bands cover none of the window's {} rows", win.height()));
   const int npix = width * height;
   const uint64_t total = uint64_t(npix) * uint64_t(settings.spp);
   const bool medium = volume_stages_;
@@ -319,6 +351,7 @@ Film Renderer::render(const RenderSettings& settings) {
   args.set("seed", cl_uint(settings.seed));
   args.set("path_sampler", cl_uint(path_sampler_id(options_.path_sampler)));
   args.set("window", make_int4(win.x0, win.y0, width, height));
+  args.set("bands", bands.packed());
   args.set("first_pass", cl_uint(settings.first_sample));
   args.set("max_depth", cl_int(max_depth));
   args.set("npix", cl_int(npix));
@@ -543,6 +576,7 @@ Film Renderer::render(const RenderSettings& settings) {
     s.x = std::ldexp(s.x, k), s.y = std::ldexp(s.y, k), s.z = std::ldexp(s.z, k);
     q2.x = std::ldexp(q2.x, 2 * k), q2.y = std::ldexp(q2.y, 2 * k), q2.z = std::ldexp(q2.z, 2 * k);
   }
+  if (!bands.all()) film = spread_rows(std::move(film), bands, win.height());
   stats_.overflowed_pixels += film.overflowed_pixels();
   stats_.render_seconds += seconds_since(t_start);
   return film;

@@ -11,6 +11,7 @@
 #include "render/device_scene.h"
 #include "render/features.h"
 #include "render/light_sampler_data.h"
+#include "row_bands.h"
 #include "scene/scene.h"
 
 #include <array>
@@ -68,7 +69,7 @@ struct alignas(16) double2 {
   double x, y;
 };
 static_assert(sizeof(double4) == 32 && sizeof(double2) == 16);
-static_assert(sizeof(Material) == 112 && sizeof(Light) == 96 && sizeof(Primitive) == 64 &&
+static_assert(sizeof(Material) == 128 && sizeof(Light) == 96 && sizeof(Primitive) == 64 &&
               sizeof(Texture) == 64 && sizeof(float2) == 8 && sizeof(Medium) == 64);
 
 // A window [x0, x1) x [y0, y1) of the film's pixels; empty: the whole film.
@@ -102,6 +103,15 @@ struct Film {
   std::vector<uint8_t> emitter_mask() const;
 };
 
+// Bands of a window's rows that a render covers (cl/row_bands.h): bands of `height` rows repeat
+// every `period` bands, and the render covers those whose number mod period is in [first, first +
+// count). The film's other rows get no samples. Every row by default.
+struct RowBands {
+  int height = 1, period = 1, first = 0, count = 1;
+  bool all() const { return first == 0 && count >= period; }
+  int4 packed() const { return make_int4(height, period, first, count); }
+};
+
 struct RenderSettings {
   int spp = 1;
   uint32_t seed = 1;
@@ -111,6 +121,7 @@ struct RenderSettings {
   // (`canopy merge`). first_sample + spp <= kMaxSpp.
   int first_sample = 0;
   PixelWindow window;
+  RowBands bands;                     // of the window's rows
   size_t wave_size = size_t(1) << 18; // paths per wave (smaller when splitting: see render())
   std::function<void(double fraction)> progress; // optional, called after each wave
 };

@@ -89,6 +89,16 @@ TextureData build_texture_data(const std::vector<TextureDesc>& textures) {
   // Images already in `texels`: (file, channels, encoding, gamma) -> their Texture (first, size).
   std::map<std::tuple<std::string, int, int, float>, Texture> loaded;
   for (const TextureDesc& desc : textures) {
+    if (desc.kind != TEXTURE_IMAGE) { // an operator or a constant: no texels
+      Texture t{};
+      t.kind = desc.kind;
+      t.nodes = desc.nodes;
+      t.scale = make_float4(desc.scale.x, desc.scale.y, desc.scale.z, 0.0f);
+      t.uvmap = desc.uvmap;
+      t.map = desc.map;
+      d.textures.push_back(t);
+      continue;
+    }
     auto key = std::make_tuple(desc.file.string(), desc.channels, int(desc.encoding),
                                desc.encoding == ImageEncoding::Gamma ? desc.gamma : 1.0f);
     auto it = loaded.find(key);
@@ -111,6 +121,8 @@ TextureData build_texture_data(const std::vector<TextureDesc>& textures) {
     t.uvmap = desc.uvmap;
     t.wrap = desc.wrap;
     t.map = desc.map;
+    t.kind = TEXTURE_IMAGE;
+    t.nodes = desc.nodes;
     d.textures.push_back(t);
   }
   return d;

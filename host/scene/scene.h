@@ -127,6 +127,13 @@ struct IntegratorSettings {
 // kernels per bounce, log2 of it).
 inline constexpr int kMaxBrdfSamples = 1024;
 
+// Whether a material reads a texture (cl/texture.h): its albedo, roughness or transmittance, or a
+// mix's amount. The kernels then need the triangles' uv and HAS_TEXTURES.
+inline bool material_textured(const Material& m) {
+  return m.albedo_texture > 0 || m.alpha_texture > 0 || m.transmittance_texture > 0 ||
+         m.mix_amount_texture > 0;
+}
+
 struct MaterialDesc {
   std::string name;
   Material gpu; // device record: type + albedo
@@ -234,6 +241,39 @@ inline MaterialDesc coated_conductor_material(std::string name, float alpha, flo
   return d;
 }
 
+// pbrt-v4's diffusetransmission: reflectance / pi on the viewer's side of the surface and
+// transmittance / pi on the other (each rgb in [0, 1]; cl/bsdf/diffuse_transmission.h).
+inline MaterialDesc diffuse_transmission_material(std::string name, float3 reflectance,
+                                                  float3 transmittance) {
+  MaterialDesc d;
+  d.name = std::move(name);
+  d.gpu = Material{};
+  d.gpu.albedo = make_float4(reflectance.x, reflectance.y, reflectance.z, 0.0f);
+  d.gpu.specular = make_float4(transmittance.x, transmittance.y, transmittance.z, 0.0f);
+  d.gpu.type = MATERIAL_DIFFUSE_TRANSMISSION;
+  return d;
+}
+// pbrt-v4's mix: material `second` (an index into Scene::materials) with probability `amount` at
+// each shading point, else `first` (cl/material_mix.h).
+inline MaterialDesc mix_material(std::string name, int first, int second, float amount) {
+  MaterialDesc d;
+  d.name = std::move(name);
+  d.gpu = Material{};
+  d.gpu.type = MATERIAL_MIX;
+  d.gpu.mix_material[0] = first;
+  d.gpu.mix_material[1] = second;
+  d.gpu.mix_amount = amount;
+  return d;
+}
+// How many mixes deep material `index` of `materials` nests (0: not a mix). The loaders refuse a
+// mix deeper than MATERIAL_MIX_MAX_DEPTH (the device resolves that many levels).
+template <class Materials> int mix_depth(const Materials& materials, int index) {
+  const Material& m = materials[size_t(index)].gpu;
+  if (m.type != MATERIAL_MIX) return 0;
+  return 1 +
+         std::max(mix_depth(materials, m.mix_material[0]), mix_depth(materials, m.mix_material[1]));
+}
+
 // An environment light's radiance map (cl/lights/environment.h): the image file, read by the
 // renderer (host/render/environment_map.h), and its projection (ENV_EQUIRECT, ENV_OCTAHEDRAL).
 struct EnvironmentMap {
@@ -248,17 +288,23 @@ struct EnvironmentMap {
 // as they are.
 enum class ImageEncoding { Auto, Linear, Srgb, Gamma };
 
-// An image texture of a material (cl/types.h Texture, cl/texture.h): the image file, read by the
-// renderer (host/render/texture_data.h), and how its values are looked up and used. A material
-// refers to it by Material::albedo_texture or alpha_texture (1 + its index in Scene::textures).
+// A node of a material's texture (cl/types.h Texture, cl/texture.h): an image (its file, read by
+// the renderer, host/render/texture_data.h, and how its values are looked up), a constant, or
+// pbrt-v4's checkerboard, mix or scale of the nodes before it. A texture is a tree of nodes in
+// postfix order in Scene::textures, each node after its inputs' subtrees (`nodes` records in all,
+// ending at the node). A material refers to its root by Material::albedo_texture, alpha_texture,
+// transmittance_texture or mix_amount_texture (1 + the root's index in Scene::textures).
 struct TextureDesc {
-  std::filesystem::path file;
+  int kind = TEXTURE_IMAGE;   // TEXTURE_*
+  int nodes = 1;              // this node and its inputs' subtrees
+  std::filesystem::path file; // an image
   std::string where; // names it in messages: "<scene file>: texture '<name>'" or "<file>:<line>"
   int channels = 3;  // 3: rgb (albedo); 1: the mean of the image's colour channels (roughness)
   ImageEncoding encoding = ImageEncoding::Auto;
   float gamma = 1.0f;       // ImageEncoding::Gamma: linear = stored^gamma
-  float3 scale{1, 1, 1};    // multiplies the filtered value (a float texture uses x)
-  float4 uvmap{1, 1, 0, 0}; // (s, t) = (x u + z, y v + w)
+  float3 scale{1, 1, 1};    // image: multiplies the filtered value (a float texture uses x);
+                            // constant: the value
+  float4 uvmap{1, 1, 0, 0}; // image, checkerboard: (s, t) = (x u + z, y v + w)
   int wrap = TEXTURE_WRAP_REPEAT;
   int map = TEXTURE_MAP_VALUE; // TEXTURE_MAP_*: how a float texture's value becomes GGX alpha
 };
@@ -291,7 +337,7 @@ struct Scene {
   // once any mesh has them; empty while none has. A triangle given without uv has pbrt-v4's
   // default (0, 0), (1, 0), (1, 1).
   std::vector<float2> triangle_uvs;
-  std::vector<TextureDesc> textures; // image textures of the materials
+  std::vector<TextureDesc> textures; // the materials' textures: trees of nodes (TextureDesc)
   std::vector<Light> lights;         // only lights that emit (zero-emission lights are skipped)
   // Lights at infinity (LIGHT_DISTANT, LIGHT_ENVIRONMENT; at most MAX_INFINITE_LIGHTS): apart from
   // `lights`, which the light samplers and the tree cover; every shading point samples each of

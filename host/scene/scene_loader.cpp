@@ -336,7 +336,7 @@ Medium parse_medium(const JsonValue& v, double3 origin) {
 // Textures).
 TextureDesc parse_texture(const JsonValue& v, const Builder& b, int channels) {
   auto o = v.as_object();
-  o.allow({"texture", "scale", "wrap", "encoding", "uv_scale", "uv_offset"});
+  o.allow({"type", "texture", "scale", "wrap", "encoding", "uv_scale", "uv_offset"});
   TextureDesc t;
   auto fv = o.req("texture");
   std::string f = fv.as_string();
@@ -389,11 +389,100 @@ TextureDesc parse_texture(const JsonValue& v, const Builder& b, int channels) {
   return t;
 }
 
-// A material's "albedo": a reflectance (rgb in [0, 1]) or an image texture.
+// The nodes of a texture input (docs/scene-format.md, Textures) appended to `out` in postfix order:
+// a constant (a number for a float input, channels 1, else a colour), an image texture, or a
+// checkerboard, mix or scale of inputs. Returns the evaluation stack it needs.
+int parse_texture_nodes(const JsonValue& v, const Builder& b, int channels,
+                        std::vector<TextureDesc>& out) {
+  if (!v.is_object()) {
+    TextureDesc c;
+    c.kind = TEXTURE_CONSTANT;
+    if (channels == 1) {
+      float k = v.as_float_nonneg();
+      c.scale = make_float3(k, k, k);
+    } else {
+      c.scale = v.as_color();
+    }
+    out.push_back(c);
+    return 1;
+  }
+  auto o = v.as_object();
+  std::string type = "image";
+  if (auto t = o.get("type")) type = t->as_enum({"image", "checkerboard", "mix", "scale"});
+  if (type == "image") {
+    out.push_back(parse_texture(v, b, channels));
+    return 1;
+  }
+  const size_t start = out.size();
+  int stack = 0;
+  auto input = [&](const JsonValue& x, int ch, int i) {
+    stack = std::max(stack, i + parse_texture_nodes(x, b, ch, out));
+  };
+  TextureDesc root;
+  if (type == "checkerboard") {
+    o.allow({"type", "tex1", "tex2", "uv_scale", "uv_offset"});
+    root.kind = TEXTURE_CHECKERBOARD;
+    input(o.req("tex1"), channels, 0);
+    input(o.req("tex2"), channels, 1);
+    auto pair = [](const JsonValue& a) {
+      if (!a.is_array() || a.array_size() != 2) a.fail("must be an array of 2 numbers");
+      return make_float2(a.at(0).as_float(), a.at(1).as_float());
+    };
+    if (auto sv = o.get("uv_scale")) {
+      float2 k = pair(*sv);
+      root.uvmap.x = k.x;
+      root.uvmap.y = k.y;
+    }
+    if (auto ov = o.get("uv_offset")) {
+      float2 d = pair(*ov);
+      root.uvmap.z = d.x;
+      root.uvmap.w = d.y;
+    }
+  } else if (type == "mix") {
+    o.allow({"type", "tex1", "tex2", "amount"});
+    root.kind = TEXTURE_MIX;
+    input(o.req("tex1"), channels, 0);
+    input(o.req("tex2"), channels, 1);
+    if (auto a = o.get("amount")) {
+      input(*a, 1, 2);
+    } else {
+      TextureDesc half;
+      half.kind = TEXTURE_CONSTANT;
+      half.scale = make_float3(0.5f, 0.5f, 0.5f);
+      out.push_back(half);
+      stack = std::max(stack, 3);
+    }
+  } else {
+    o.allow({"type", "tex", "scale"});
+    root.kind = TEXTURE_SCALE;
+    input(o.req("tex"), channels, 0);
+    input(o.req("scale"), 1, 1);
+  }
+  root.nodes = int(out.size() - start) + 1;
+  out.push_back(root);
+  if (stack > TEXTURE_STACK)
+    v.fail(fmt::format("textures nested too deeply (this one needs {} values at once, at most {})",
+                       stack, TEXTURE_STACK));
+  return stack;
+}
+
+// A texture input of a material as Scene::textures nodes: 1 + its root's index, whose `map` is
+// `map`.
+int add_texture_input(const JsonValue& v, Builder& b, int channels, int map) {
+  std::vector<TextureDesc> nodes;
+  parse_texture_nodes(v, b, channels, nodes);
+  nodes.back().map = map;
+  int id = 0;
+  for (TextureDesc& t : nodes)
+    id = add_texture(b.scene, std::move(t));
+  return id;
+}
+
+// A material's "albedo": a reflectance (rgb in [0, 1]) or a texture.
 void parse_albedo(const JsonValue& v, Builder& b, MaterialDesc& d) {
   if (v.is_object()) {
     d.gpu.albedo = make_float4(0, 0, 0, 0);
-    d.gpu.albedo_texture = add_texture(b.scene, parse_texture(v, b, 3));
+    d.gpu.albedo_texture = add_texture_input(v, b, 3, TEXTURE_MAP_VALUE);
   } else {
     d.gpu.albedo = f4_from3(v.as_albedo(), 0.0f);
   }
@@ -402,9 +491,7 @@ void parse_albedo(const JsonValue& v, Builder& b, MaterialDesc& d) {
 // A material's "roughness": r in [0, 1] (GGX alpha = r^2) or a texture of r.
 float parse_roughness(const JsonValue& v, Builder& b, MaterialDesc& d) {
   if (!v.is_object()) return v.as_float_in(0.0f, 1.0f);
-  TextureDesc t = parse_texture(v, b, 1);
-  t.map = TEXTURE_MAP_ALPHA_SQUARE;
-  d.gpu.alpha_texture = add_texture(b.scene, std::move(t));
+  d.gpu.alpha_texture = add_texture_input(v, b, 1, TEXTURE_MAP_ALPHA_SQUARE);
   return 0.5f; // the material's constant, unused where the texture applies
 }
 
@@ -451,12 +538,48 @@ MaterialDesc parse_material(const JsonValue& v, Builder& b) {
   if (name.empty()) nv.fail("must not be empty");
   std::string type = "diffuse"; // the default keeps scenes written before glossy materials valid
   if (auto t = o.get("type"))
-    type = t->as_enum(
-        {"diffuse", "conductor", "plastic", "dielectric", "coated_diffuse", "coated_conductor"});
+    type = t->as_enum({"diffuse", "conductor", "plastic", "dielectric", "coated_diffuse",
+                       "coated_conductor", "diffuse_transmission", "mix"});
   if (type == "diffuse") {
     o.allow({"name", "type", "albedo"});
     MaterialDesc d = diffuse_material(name, make_float3(0, 0, 0));
     parse_albedo(o.req("albedo"), b, d);
+    return d;
+  }
+  if (type == "diffuse_transmission") {
+    o.allow({"name", "type", "albedo", "transmittance"});
+    MaterialDesc d = diffuse_transmission_material(name, make_float3(0.25f, 0.25f, 0.25f),
+                                                   make_float3(0.25f, 0.25f, 0.25f));
+    if (auto a = o.get("albedo")) parse_albedo(*a, b, d);
+    if (auto t = o.get("transmittance")) {
+      if (t->is_object())
+        d.gpu.transmittance_texture = add_texture_input(*t, b, 3, TEXTURE_MAP_VALUE);
+      else
+        d.gpu.specular = f4_from3(t->as_albedo(), 0.0f);
+    }
+    float3 r = xyz_of(d.gpu.albedo), tr = xyz_of(d.gpu.specular);
+    if (!d.gpu.albedo_texture && !d.gpu.transmittance_texture &&
+        (r.x + tr.x > 1.0f || r.y + tr.y > 1.0f || r.z + tr.z > 1.0f))
+      o.fail("albedo + transmittance must be at most 1 in every channel (energy conservation)");
+    return d;
+  }
+  if (type == "mix") {
+    o.allow({"name", "type", "materials", "amount"});
+    if (name == "default") nv.fail("the default material cannot be a mix");
+    auto mv = o.req("materials");
+    if (!mv.is_array() || mv.array_size() != 2) mv.fail("must be an array of 2 material names");
+    int parts[2] = {b.material_ref(mv.at(0)), b.material_ref(mv.at(1))};
+    for (int i = 0; i < 2; ++i)
+      if (mix_depth(b.scene.materials, parts[i]) >= MATERIAL_MIX_MAX_DEPTH)
+        mv.at(size_t(i)).fail(
+            fmt::format("mixes nested more than {} deep", MATERIAL_MIX_MAX_DEPTH));
+    MaterialDesc d = mix_material(name, parts[0], parts[1], 0.5f);
+    if (auto a = o.get("amount")) {
+      if (a->is_object())
+        d.gpu.mix_amount_texture = add_texture_input(*a, b, 1, TEXTURE_MAP_VALUE);
+      else
+        d.gpu.mix_amount = a->as_float_in(0.0f, 1.0f);
+    }
     return d;
   }
   if (type == "conductor") {

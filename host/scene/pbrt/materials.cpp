@@ -267,6 +267,69 @@ int Reader::material(const Loc& loc, Params& p, const std::string& type, const s
     // pbrt-v4's thin dielectric is smooth; the dielectric may be rough (GGX).
     float r = thin ? 0.0f : roughness();
     md = dielectric_material(mname, ior, thin, r * r);
+  } else if (type == "diffusetransmission") {
+    // pbrt-v4's DiffuseTransmissionMaterial: R / pi on wo's side, T / pi on the other, with
+    // R = clamp(scale reflectance) and T = clamp(scale transmittance), both 0.25 by default.
+    double scale = p.get_float("scale", 1.0);
+    if (!(scale >= 0.0) || !std::isfinite(float(scale)))
+      fail(p.find("scale")->loc,
+           fmt::format("{}: \"float scale\": must be >= 0 and a finite float", p.what()));
+    const float k = float(scale);
+    int transmittance_texture = 0;
+    auto value = [&](const char* key, int* tex) {
+      const float3 def = make_float3(0.25f, 0.25f, 0.25f);
+      if (Param* q = p.find(key); q && q->type == "texture") {
+        std::optional<NamedTexture> t = texture_param(p, key, false);
+        if (t->kind == K::Image)
+          *tex = texture_index(scaled_texture(q->loc, *t, k, false), 3, TEXTURE_MAP_VALUE);
+        return clamp01((t->kind == K::Constant ? t->value : def) * k);
+      }
+      return clamp01(p.spectrum(key, Params::Use::Reflectance).value_or(def) * k);
+    };
+    float3 r = value("reflectance", &albedo_texture);
+    float3 t = value("transmittance", &transmittance_texture);
+    md = diffuse_transmission_material(mname, r, t);
+    md.gpu.transmittance_texture = transmittance_texture;
+  } else if (type == "mix") {
+    // pbrt-v4's MixMaterial: two named materials, the second chosen with probability `amount`
+    // (cl/material_mix.h).
+    Param* q = p.find("materials");
+    if (!q || q->type != "string" || q->strs.size() != 2)
+      fail(q ? q->loc : loc,
+           fmt::format("{}: needs \"string materials\" with two material names", p.what()));
+    int parts[2];
+    for (int i = 0; i < 2; ++i) {
+      auto it = named_materials_.find(q->strs[size_t(i)]);
+      if (it == named_materials_.end())
+        fail(q->loc, fmt::format("{}: \"string materials\": no material named \"{}\"", p.what(),
+                                 printable(q->strs[size_t(i)])));
+      if (interface_materials_.count(it->second))
+        fail(q->loc, fmt::format("{}: \"string materials\": \"{}\" is an interface, which a "
+                                 "mix cannot hold",
+                                 p.what(), printable(q->strs[size_t(i)])));
+      parts[i] = it->second;
+    }
+    if (mix_depth(scene_.materials, parts[0]) >= MATERIAL_MIX_MAX_DEPTH ||
+        mix_depth(scene_.materials, parts[1]) >= MATERIAL_MIX_MAX_DEPTH)
+      fail(loc,
+           fmt::format("{}: mixes nested more than {} deep", p.what(), MATERIAL_MIX_MAX_DEPTH));
+    float amount = 0.5f;
+    int amount_texture = 0;
+    if (Param* a = p.find("amount"); a && a->type == "texture") {
+      std::optional<NamedTexture> t = texture_param(p, "amount", true);
+      if (t->kind == K::Image)
+        amount_texture = texture_index(*t, 1, TEXTURE_MAP_VALUE);
+      else if (t->kind == K::Constant)
+        amount = t->value.x;
+    } else if (a) {
+      amount = to_float(p.get_float("amount", 0.5));
+    }
+    md = mix_material(mname, parts[0], parts[1], amount);
+    md.gpu.mix_amount_texture = amount_texture;
+    p.find("type");
+    p.finish();
+    scene_.materials.push_back(md);
+    return int(scene_.materials.size()) - 1;
   } else if (type == "interface") {
     // pbrt-v4's interface bounds a medium and is otherwise invisible: its shapes are not added
     // (media.cpp renders the medium's extent).

@@ -77,14 +77,17 @@ struct ObjectPart {
   Transform xf; // the shape's CTM at its definition (object -> instance space)
 };
 
-// A named pbrt-v4 texture (the format page, "Textures") as far as Canopy can use it: an image map
-// (with its scale folded in), a constant, or a class Canopy cannot render (warned where it is
-// defined; a material using it keeps the parameter's constant default).
+// A named pbrt-v4 texture (the format page, "Textures") as far as Canopy can use it: a texture
+// the device evaluates (Kind::Image: an image map with its scale folded in, or a checkerboard, mix
+// or scale over images and constants), a constant, or a class Canopy cannot render (warned where
+// it is defined; a material using it keeps the parameter's constant default).
 struct NamedTexture {
   enum class Kind { Image, Constant, Unsupported };
   Kind kind = Kind::Unsupported;
   std::string name;
-  TextureDesc desc;               // Image: all but channels and map, which depend on the use
+  TextureDesc desc;               // an image alone: all but channels and map (set by the use)
+  std::vector<TextureDesc> tree;  // an operator: its nodes in postfix order (scene.h TextureDesc)
+  int stack = 1;                  // the evaluation stack it needs (at most TEXTURE_STACK)
   float3 value{1.0f, 1.0f, 1.0f}; // Constant (a float texture: x = y = z)
 };
 
@@ -143,6 +146,14 @@ private:
   // The value for Material::albedo_texture / alpha_texture of an image texture used with
   // `channels` and `map` (one Scene::textures entry per named texture and use).
   int texture_index(const NamedTexture& t, int channels, int map);
+  // A texture input of an operator texture or a material: the texture a parameter names or its
+  // constant value (`def` where absent).
+  NamedTexture texture_input(Params& p, std::string_view name, bool is_float, float3 def);
+  // pbrt-v4's checkerboard, mix and scale textures (textures.cpp).
+  NamedTexture operator_texture(const Loc& loc, Params& p, const std::string& name,
+                                const std::string& cls, bool is_float);
+  // `t` times the constant `k` (a material's "scale"): the same texture where k is 1.
+  NamedTexture scaled_texture(const Loc& loc, const NamedTexture& t, float k, bool is_float);
   void add_mesh(const Loc& loc, Mesh& m, const Transform& ctm);
   Transform world(const Transform& ctm) const { return ctm.then(world_fix_); }
 

@@ -13,11 +13,56 @@
 
 namespace canopy::pbrt {
 
+namespace {
+
+using K = NamedTexture::Kind;
+
+// The nodes of `t` as an input whose values are floats (is_float: an image is read as one channel,
+// the mean of its colours) or rgb: its tree, its image or its constant.
+std::vector<TextureDesc> texture_nodes(const NamedTexture& t, bool is_float) {
+  if (!t.tree.empty()) return t.tree;
+  TextureDesc d;
+  if (t.kind == K::Constant) {
+    d.kind = TEXTURE_CONSTANT;
+    d.scale = t.value;
+    return {d};
+  }
+  d = t.desc;
+  d.kind = TEXTURE_IMAGE;
+  d.nodes = 1;
+  d.channels = is_float ? 1 : 3;
+  d.map = TEXTURE_MAP_VALUE;
+  return {d};
+}
+
+// The operator `kind` (TEXTURE_CHECKERBOARD, _MIX, _SCALE) over `inputs` (each a texture and
+// whether it is a float input), as a tree in postfix order.
+NamedTexture compose(int kind, const std::vector<std::pair<const NamedTexture*, bool>>& inputs,
+                     float4 uvmap = make_float4(1, 1, 0, 0)) {
+  NamedTexture t;
+  t.kind = K::Image;
+  t.stack = 0;
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    std::vector<TextureDesc> n = texture_nodes(*inputs[i].first, inputs[i].second);
+    t.tree.insert(t.tree.end(), n.begin(), n.end());
+    t.stack = std::max(t.stack, int(i) + inputs[i].first->stack);
+  }
+  TextureDesc root;
+  root.kind = kind;
+  root.uvmap = uvmap;
+  root.nodes = int(t.tree.size()) + 1;
+  t.tree.push_back(root);
+  return t;
+}
+
+} // namespace
+
 // The format page, "Textures": `Texture "name" "float"|"spectrum" "class" params`. Canopy renders
-// "imagemap" (pbrt-v4 FloatImageTexture / SpectrumImageTexture), "constant", and "scale" when it
-// multiplies one of those by a constant (folded into the image's scale, as pbrt-v4's
-// FloatScaledTexture::Create does). Other classes warn here; a material using one keeps the
-// parameter's constant default.
+// "imagemap" (pbrt-v4 FloatImageTexture / SpectrumImageTexture), "constant", and pbrt-v4's
+// "checkerboard" (2D, uv mapping), "mix" and "scale" over those (cl/texture.h evaluates them as
+// a tree; constants are folded, and a scale of an image by a constant goes into the image's
+// scale, as pbrt-v4's FloatScaledTexture::Create does). Other classes warn here; a material using
+// one keeps the parameter's constant default.
 void Reader::texture(const Token& d, Params& p, const std::string& name, const std::string& type,
                      const std::string& cls, const std::filesystem::path& dir) {
   const Loc& loc = d.loc;
@@ -41,42 +86,121 @@ void Reader::texture(const Token& d, Params& p, const std::string& name, const s
     } else {
       t.value = p.spectrum("value", Params::Use::Reflectance).value_or(make_float3(1, 1, 1));
     }
-  } else if (cls == "scale") {
-    // pbrt-v4 FloatScaledTexture / SpectrumScaledTexture: tex * scale, both textures (default 1).
-    std::optional<NamedTexture> tex = texture_param(p, "tex", is_float),
-                                sc = texture_param(p, "scale", true);
-    NamedTexture one;
-    one.kind = NamedTexture::Kind::Constant;
-    NamedTexture a = tex.value_or(one), b = sc.value_or(one);
-    using K = NamedTexture::Kind;
-    if (a.kind == K::Constant && b.kind == K::Image && is_float) std::swap(a, b);
-    if (a.kind == K::Unsupported || b.kind == K::Unsupported) {
-      t.kind = K::Unsupported; // warned where it was defined
-    } else if (b.kind == K::Image) {
-      warn(loc, fmt::format("{}: \"scale\" of {}: Canopy multiplies an image only by a constant "
-                            "(the material's constant default used), ignored",
-                            p.what(), a.kind == K::Image ? "two images" : "an image scale"));
-      t.kind = K::Unsupported;
-    } else if (a.kind == K::Image) {
-      t = a;
-      t.desc.scale = t.desc.scale * b.value.x;
-      t.desc.where = fmt::format("{}:{}: texture \"{}\"", *loc.file, loc.line, name);
-    } else {
-      t.kind = K::Constant;
-      t.value = a.value * b.value.x;
-    }
+  } else if (cls == "scale" || cls == "mix" || cls == "checkerboard") {
+    t = operator_texture(loc, p, name, cls, is_float);
   } else {
-    static const std::set<std::string> known = {"bilerp", "checkerboard", "directionmix", "dots",
-                                                "fbm",    "marble",       "mix",          "ptex",
-                                                "windy",  "wrinkled"};
+    static const std::set<std::string> known = {"bilerp", "directionmix", "dots",  "fbm",
+                                                "marble", "ptex",         "windy", "wrinkled"};
     warn(loc, fmt::format("{}: {} texture class \"{}\" is not supported (a material using it "
                           "keeps its constant default), ignored",
                           p.what(), known.count(cls) ? "the" : "unknown", printable(cls)));
     p.mark_all_used();
   }
+  if (t.stack > TEXTURE_STACK)
+    fail(loc, fmt::format("{}: textures nested too deeply (the texture needs {} values at once, "
+                          "Canopy evaluates at most {})",
+                          p.what(), t.stack, TEXTURE_STACK));
   p.finish();
   t.name = name;
   named[name] = std::move(t);
+}
+
+NamedTexture Reader::texture_input(Params& p, std::string_view name, bool is_float, float3 def) {
+  NamedTexture c;
+  c.kind = K::Constant;
+  c.value = def;
+  return texture_param(p, name, is_float).value_or(c);
+}
+
+NamedTexture Reader::operator_texture(const Loc& loc, Params& p, const std::string& name,
+                                      const std::string& cls, bool is_float) {
+  const float3 zero = make_float3(0, 0, 0), one = make_float3(1, 1, 1);
+  NamedTexture t;
+  if (cls == "scale") {
+    // pbrt-v4 FloatScaledTexture / SpectrumScaledTexture: tex * scale, both textures (default 1).
+    NamedTexture a = texture_input(p, "tex", is_float, one),
+                 b = texture_input(p, "scale", true, one);
+    if (a.kind == K::Unsupported || b.kind == K::Unsupported) return t; // warned where defined
+    // An image (or any texture) times a constant: the constant folds into it (an image's scale).
+    auto fold = [&](const NamedTexture& x, float k) {
+      NamedTexture r = scaled_texture(loc, x, k, is_float);
+      if (r.kind == K::Image && r.tree.empty())
+        r.desc.where = fmt::format("{}:{}: texture \"{}\"", *loc.file, loc.line, printable(name));
+      return r;
+    };
+    if (b.kind == K::Constant) return fold(a, b.value.x);
+    if (a.kind == K::Constant && is_float) return fold(b, a.value.x); // float: both are scalars
+    return compose(TEXTURE_SCALE, {{&a, is_float}, {&b, true}});
+  }
+  if (cls == "mix") {
+    // pbrt-v4 FloatMixTexture / SpectrumMixTexture: (1 - amount) tex1 + amount tex2.
+    NamedTexture a = texture_input(p, "tex1", is_float, zero),
+                 b = texture_input(p, "tex2", is_float, one),
+                 m = texture_input(p, "amount", true, make_float3(0.5f, 0.5f, 0.5f));
+    if (a.kind == K::Unsupported || b.kind == K::Unsupported || m.kind == K::Unsupported) return t;
+    if (a.kind == K::Constant && b.kind == K::Constant && m.kind == K::Constant) {
+      t.kind = K::Constant;
+      t.value = a.value * (1.0f - m.value.x) + b.value * m.value.x;
+      return t;
+    }
+    return compose(TEXTURE_MIX, {{&a, is_float}, {&b, is_float}, {&m, true}});
+  }
+  // checkerboard: pbrt-v4 FloatCheckerboardTexture / SpectrumCheckerboardTexture, tex1 (default 1)
+  // where floor(s) + floor(t) is even, tex2 (default 0) where it is odd.
+  int dim = 2;
+  if (Param* q = p.one("dimension", {"integer"})) {
+    if (q->nums[0] != 2 && q->nums[0] != 3)
+      fail(q->loc, fmt::format("{}: \"integer dimension\" {}: a checkerboard has 2 or 3 "
+                               "dimensions",
+                               p.what(), q->nums[0]));
+    dim = int(q->nums[0]);
+  }
+  if (dim == 3) {
+    warn(p.find("dimension")->loc,
+         fmt::format("{}: a 3D checkerboard is not supported (a material using it keeps its "
+                     "constant default), ignored",
+                     p.what()));
+    p.mark_all_used();
+    return t;
+  }
+  NamedTexture a = texture_input(p, "tex1", is_float, one),
+               b = texture_input(p, "tex2", is_float, zero);
+  if (a.kind == K::Unsupported || b.kind == K::Unsupported) return t;
+  std::string mapping = p.get_string("mapping").value_or("uv");
+  if (mapping != "uv") {
+    warn(p.find("mapping")->loc,
+         fmt::format("{}: \"string mapping\" \"{}\": only \"uv\" mapping is supported (uv used), "
+                     "ignored",
+                     p.what(), printable(mapping)));
+    for (const char* planar : {"v1", "v2"}) // the planar mapping's vectors
+      p.find(planar);
+  }
+  double uvm[4] = {p.get_float("uscale", 1.0), p.get_float("vscale", 1.0),
+                   p.get_float("udelta", 0.0), p.get_float("vdelta", 0.0)};
+  for (double x : uvm)
+    if (!std::isfinite(float(x)))
+      fail(loc, fmt::format("{}: uscale, vscale, udelta, vdelta: a value is too large", p.what()));
+  return compose(TEXTURE_CHECKERBOARD, {{&a, is_float}, {&b, is_float}},
+                 make_float4(float(uvm[0]), float(uvm[1]), float(uvm[2]), float(uvm[3])));
+}
+
+NamedTexture Reader::scaled_texture(const Loc& loc, const NamedTexture& t, float k, bool is_float) {
+  if (k == 1.0f || t.kind == K::Unsupported) return t;
+  NamedTexture out = t;
+  out.name = fmt::format("{}\n*{}", t.name, k); // its own Scene::textures entry
+  if (t.kind == K::Constant) {
+    out.value = t.value * k;
+  } else if (t.tree.empty()) { // an image: into its scale
+    out.desc.scale = t.desc.scale * k;
+    out.desc.where = fmt::format("{}:{}: texture \"{}\"", *loc.file, loc.line, printable(t.name));
+  } else {
+    NamedTexture c;
+    c.kind = K::Constant;
+    c.value = make_float3(k, k, k);
+    out = compose(TEXTURE_SCALE, {{&t, is_float}, {&c, true}});
+    out.name = fmt::format("{}\n*{}", t.name, k);
+  }
+  return out;
 }
 
 NamedTexture Reader::image_texture(const Loc& loc, Params& p, const std::string& name,
@@ -208,10 +332,19 @@ std::optional<NamedTexture> Reader::texture_param(Params& p, std::string_view na
 int Reader::texture_index(const NamedTexture& t, int channels, int map) {
   std::string key = fmt::format("{}{}{}\n{}", channels == 1 ? 'f' : 's', channels, map, t.name);
   if (auto it = texture_indices_.find(key); it != texture_indices_.end()) return it->second;
-  TextureDesc td = t.desc;
-  td.channels = channels;
-  td.map = map;
-  int id = add_texture(scene_, std::move(td));
+  int id = 0;
+  if (!t.tree.empty()) {
+    for (size_t i = 0; i < t.tree.size(); ++i) {
+      TextureDesc td = t.tree[i];
+      if (i + 1 == t.tree.size()) td.map = map;
+      id = add_texture(scene_, std::move(td));
+    }
+  } else {
+    TextureDesc td = t.desc;
+    td.channels = channels;
+    td.map = map;
+    id = add_texture(scene_, std::move(td));
+  }
   texture_indices_.emplace(key, id);
   return id;
 }
