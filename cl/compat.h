@@ -15,6 +15,7 @@
 #define make_float4(a, b, c, d) ((float4)((a), (b), (c), (d)))
 #define make_int4(a, b, c, d) ((int4)((a), (b), (c), (d)))
 #define make_int2(a, b) ((int2)((a), (b)))
+#define make_uint4(a, b, c, d) ((uint4)((a), (b), (c), (d)))
 #define xyz_of(v) ((v).xyz)
 #define FLT_INF INFINITY
 #pragma OPENCL FP_CONTRACT OFF
@@ -81,7 +82,10 @@ struct alignas(16) int4 {
 struct alignas(8) int2 {
   int x, y;
 };
-static_assert(sizeof(float4) == 16 && sizeof(int4) == 16);
+struct alignas(16) uint4 {
+  uint x, y, z, w;
+};
+static_assert(sizeof(float4) == 16 && sizeof(int4) == 16 && sizeof(uint4) == 16);
 
 INLINE float2 make_float2(float a, float b) {
   return {a, b};
@@ -97,6 +101,12 @@ INLINE int4 make_int4(int a, int b, int c, int d) {
 }
 INLINE int2 make_int2(int a, int b) {
   return {a, b};
+}
+INLINE uint4 make_uint4(uint a, uint b, uint c, uint d) {
+  return {a, b, c, d};
+}
+INLINE bool operator==(uint4 a, uint4 b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w;
 }
 using std::max;
 using std::min;

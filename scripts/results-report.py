@@ -283,6 +283,9 @@ def main():
                     help="the label of --docs' budget in the wall-clock section")
     ap.add_argument("--default-text", default="scripts/results-default.md",
                     help="the reasoning behind the default estimator (Markdown), quoted as is")
+    ap.add_argument("--sampler-text", default="scripts/results-sampler.md",
+                    help="the path sampler's measurements (Markdown, made by hand with the "
+                         "commands it quotes), appended as is when the file exists")
     args = ap.parse_args()
     docs_rel = os.path.relpath(args.docs, "docs") if not os.path.isabs(args.docs) else args.docs
 
@@ -380,6 +383,9 @@ def main():
     if table_names:
         out += default_section(args.default_text, candidates, table_names)
     out += sections
+    if os.path.exists(args.sampler_text):
+        with open(args.sampler_text) as f:
+            out += ["", f.read().rstrip("\n")]
     print("\n".join(out))
 
 

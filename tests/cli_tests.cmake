@@ -140,6 +140,11 @@ canopy_cli_test(cli_max_depth_too_large -DSCENE=${CANOPY_LIMITS_DATA}/tiny.json
 canopy_cli_test(cli_render_no_mis
   "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--light-sampler|tree-split|--no-mis|--out|${CANOPY_SCRATCH}/no_mis.exr"
   "-DSTDERR=sampler tree-split (threshold 0.25, max cut 64, no MIS)" -P ${CANOPY_CHECK_CLI})
+# The path sampler is sobol or independent (render --sampler, converge --sampler or a suffix).
+canopy_cli_test(cli_render_bad_path_sampler
+  "-DARGS=render|${CANOPY_LIMITS_DATA}/tiny.json|--sampler|halton|--out|${CANOPY_SCRATCH}/halton.exr"
+  -DRC=2 "-DSTDERR=--sampler: 'halton': must be independent or sobol"
+  -DONE_LINE=ON -P ${CANOPY_CHECK_CLI})
 canopy_cli_test(cli_converge_bad_mis_suffix
   "-DARGS=converge|${CANOPY_LIMITS_DATA}/tiny.json|--reference|${CANOPY_SCRATCH}/none.exr|--samplers|power,tree-split:0.5/mis"
   -DRC=2 "-DSTDERR=--samplers: 'tree-split:0.5/mis': unknown or repeated suffix '/mis' (/nomis: MIS off; /equal: brdf-mis with equal allocation)"

@@ -22,6 +22,7 @@
 #include "render/light_sampler_data.h"
 #include "render/renderer.h"
 #include "rng.h"
+#include "sampler.h"
 
 #include "support/glossy_points.h"
 
@@ -179,7 +180,14 @@ protected:
       p.hits.push_back(h);
       p.throughput.push_back(make_float4(0.2f + u(rng), 0.2f + u(rng), 0.2f + u(rng), 0));
       p.radiance.push_back(make_float4(u(rng), u(rng), u(rng), 0));
-      p.rng.push_back(uint32_t(rng()));
+      // Every third path draws from the Sobol sampler (key, sample index; shade_surface and
+      // shade_volume set the vertex's dimensions), the others from their PCG state.
+      if (i % 3 == 1)
+        p.rng.push_back(
+            make_uint4(uint32_t(rng()), uint32_t(rng() % 4096), 0u, PATH_SAMPLER_SOBOL));
+      else
+        p.rng.push_back(make_uint4(uint32_t(rng()), 0u, 0u, PATH_SAMPLER_INDEPENDENT));
+      p.light_u.push_back(make_float2(0.0f, 0.0f)); // (shade_surface writes it for sobol)
       // Previous vertex: a point in the room, a normal, and the pdf of the BSDF ray (0: none).
       float3 sp = make_float3(-2 + 4 * u(rng), 0.5f + 2 * u(rng), -2 + 4 * u(rng)) - origin_;
       p.shade_P.push_back(f4_from3(sp, i % 3 == 0 ? 0.0f : u(rng)));
@@ -257,6 +265,8 @@ void compare_paths(const Paths& dev, const Paths& ref, const std::vector<int>& w
     expect_close4(dev.radiance[p], ref.radiance[p], at + " radiance");
     expect_close4(dev.shade_P[p], ref.shade_P[p], at + " shade_P");
     EXPECT_EQ(dev.rng[p], ref.rng[p]) << at;
+    EXPECT_EQ(dev.light_u[p].x, ref.light_u[p].x) << at;
+    EXPECT_EQ(dev.light_u[p].y, ref.light_u[p].y) << at;
     expect_close(dev.shade_N[p].x, ref.shade_N[p].x, at + " N");
     EXPECT_EQ(float_as_uint_(dev.shade_N[p].w), float_as_uint_(ref.shade_N[p].w)) << at << " seed";
     expect_close4(dev.shade_f[p], ref.shade_f[p], at + " shade_f");
@@ -693,7 +703,7 @@ protected:
                                  KernelFeatures::all(SAMPLER_UNIFORM).build_options());
   }
   void check_accumulate(int npix, int wave, uint64_t base);
-  void check_generate(int4 window, uint32_t first_pass, RowBands bands = {});
+  void check_generate(int4 window, uint32_t first_pass, uint32_t path_sampler, RowBands bands = {});
   ClRuntime rt_;
   cl::Program program_;
 };
@@ -704,9 +714,11 @@ protected:
 TEST_F(KernelUtilities, GenerateMatchesAPinholeCamera) {
   for (int4 window : {make_int4(0, 0, 37, 23), make_int4(5, 3, 11, 7)}) {
     const uint32_t first_pass = window.z == 37 ? 0 : 17;
-    check_generate(window, first_pass);
-    check_generate(window, first_pass, RowBands{2, 3, 1, 2});
-    check_generate(window, first_pass, RowBands{4, 2, 0, 1});
+    for (uint32_t ps : {PATH_SAMPLER_INDEPENDENT, PATH_SAMPLER_SOBOL}) {
+      check_generate(window, first_pass, ps);
+      check_generate(window, first_pass, ps, RowBands{2, 3, 1, 2});
+      check_generate(window, first_pass, ps, RowBands{4, 2, 0, 1});
+    }
   }
 }
 
@@ -728,9 +740,11 @@ TEST(RowBands, CoveredRowsAreTheBandsInThePeriod) {
           }
 }
 
-void KernelUtilities::check_generate(int4 window, uint32_t first_pass, RowBands bands) {
-  SCOPED_TRACE(::testing::Message() << "bands " << bands.height << " " << bands.period << " "
-                                    << bands.first << " " << bands.count);
+void KernelUtilities::check_generate(int4 window, uint32_t first_pass, uint32_t path_sampler,
+                                     RowBands bands) {
+  SCOPED_TRACE(::testing::Message()
+               << "path sampler " << path_sampler << " bands " << bands.height << " "
+               << bands.period << " " << bands.first << " " << bands.count);
   window.w = covered_rows(bands.packed(), window.w); // the rows the render covers
   Camera cam;
   cam.position = make_float3(1, 2, 3);
@@ -742,6 +756,7 @@ void KernelUtilities::check_generate(int4 window, uint32_t first_pass, RowBands 
   KernelArgs args;
   args.set("cam", to_device(rt_, cp));
   args.set("seed", cl_uint(99));
+  args.set("path_sampler", cl_uint(path_sampler));
   args.set("window", window);
   args.set("bands", bands.packed());
   args.set("first_pass", cl_uint(first_pass));
@@ -749,14 +764,14 @@ void KernelUtilities::check_generate(int4 window, uint32_t first_pass, RowBands 
   args.set("count", cl_int(n));
   for (const char* name : {"ray_o", "ray_d", "throughput", "radiance"})
     args.set(name, cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(float4)));
-  args.set("rng", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(uint32_t)));
+  args.set("rng", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(uint4)));
   args.set("ray_queue", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int)));
   args.set("path_counts", cl::Buffer(rt_.context(), CL_MEM_READ_WRITE, n * sizeof(int4)));
   BoundKernel k(program_, "generate", args);
   enqueue_1d(rt_.queue(), k.bind(), n);
   auto o = from_device<float4>(rt_, args.buffer("ray_o"), n);
   auto d = from_device<float4>(rt_, args.buffer("ray_d"), n);
-  auto rng = from_device<uint32_t>(rt_, args.buffer("rng"), n);
+  auto rng = from_device<uint4>(rt_, args.buffer("rng"), n);
   auto queue = from_device<int>(rt_, args.buffer("ray_queue"), n);
   // Independent reference: the pixel's jittered point on the image plane, from the camera basis.
   float3 fwd = normalize(cam.look_at - cam.position), right = normalize(cross(fwd, cam.up));
@@ -775,15 +790,21 @@ void KernelUtilities::check_generate(int4 window, uint32_t first_pass, RowBands 
     for (int left = int(in_win) / window.z; !(covered(row) && left-- == 0);)
       ++row;
     uint32_t pixel = uint32_t((window.y + row) * w + window.x + int(in_win) % window.z);
-    PathRng r = rng_seed(99, pixel, pass);
-    float jx = rng_next_float(&r), jy = rng_next_float(&r);
-    float sx = (float(pixel % w) + jx) / float(w), sy = (float(pixel / w) + jy) / float(h);
+    float2 j;
+    uint4 state = path_sampler_start(path_sampler, 99, pixel, pass, &j);
+    if (path_sampler == PATH_SAMPLER_INDEPENDENT) { // the PCG stream's first two numbers
+      PathRng r = rng_seed(99, pixel, pass);
+      ASSERT_EQ(j.x, rng_next_float(&r));
+      ASSERT_EQ(j.y, rng_next_float(&r));
+      ASSERT_EQ(state.x, r.state);
+    }
+    float sx = (float(pixel % w) + j.x) / float(w), sy = (float(pixel / w) + j.y) / float(h);
     float3 dir = normalize(fwd + right * ((2 * sx - 1) * tw) + up * ((1 - 2 * sy) * th));
     ASSERT_NEAR(d[size_t(i)].x, dir.x, 1e-5f) << i;
     ASSERT_NEAR(d[size_t(i)].y, dir.y, 1e-5f) << i;
     ASSERT_NEAR(d[size_t(i)].z, dir.z, 1e-5f) << i;
     ASSERT_EQ(o[size_t(i)].x, 1.0f);
-    ASSERT_EQ(rng[size_t(i)], r.state) << i;
+    ASSERT_EQ(rng[size_t(i)], state) << i;
     ASSERT_EQ(queue[size_t(i)], i);
   }
 }

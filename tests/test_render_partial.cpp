@@ -5,7 +5,8 @@
 // - a cropped render equals the full render's pixels in the window;
 // - tiles x ranges merge into the full render, and the merge reports one uniform sample range.
 // On scenes that take every stage: glossy-cornell (brdf-mis: splitting, BRDF-oriented rounds) and
-// spiral-fog (a medium: segment light samples).
+// spiral-fog (a medium: segment light samples), with each path sampler (independent, sobol: a
+// Sobol sample's numbers depend on its global sample index alone, cl/sampler.h).
 #include "image/partial_image.h"
 #include "render/renderer.h"
 
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 using namespace canopy;
@@ -23,15 +25,16 @@ namespace {
 
 constexpr int kW = 32, kH = 24, kSpp = 8;
 
-class PartialRender : public ::testing::TestWithParam<const char*> {
+class PartialRender : public ::testing::TestWithParam<std::tuple<const char*, const char*>> {
 protected:
   void SetUp() override {
-    scene_ = load_scene(std::string(CANOPY_SCENES_DIR) + "/" + GetParam() + ".json");
+    scene_ = load_scene(std::string(CANOPY_SCENES_DIR) + "/" + std::get<0>(GetParam()) + ".json");
     scene_.film.width = kW;
     scene_.film.height = kH;
     scene_.integrator.max_depth = std::min(scene_.integrator.max_depth, 3);
     RendererOptions opt;
     opt.light_sampler = "brdf-mis";
+    opt.path_sampler = std::get<1>(GetParam());
     renderer_ = std::make_unique<Renderer>(rt_, scene_, opt);
   }
 
@@ -185,4 +188,13 @@ TEST_P(PartialRender, BandsOfRowsEqualTheFullRendersRows) {
   EXPECT_EQ(covered, 12);
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, PartialRender, ::testing::Values("glossy-cornell", "spiral-fog"));
+INSTANTIATE_TEST_SUITE_P(Scenes, PartialRender,
+                         ::testing::Combine(::testing::Values("glossy-cornell", "spiral-fog"),
+                                            ::testing::Values("independent", "sobol")),
+                         [](const auto& p) {
+                           std::string name =
+                               std::string(std::get<0>(p.param)) + "_" + std::get<1>(p.param);
+                           for (char& c : name)
+                             if (c == '-') c = '_';
+                           return name;
+                         });

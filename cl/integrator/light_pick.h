@@ -7,6 +7,7 @@
 #ifndef CANOPY_INTEGRATOR_LIGHT_PICK_H
 #define CANOPY_INTEGRATOR_LIGHT_PICK_H
 
+#include "../sampler.h"
 #include "brdf_mis.h"
 #include "light_point.h"
 #include "light_sampler.h"
@@ -18,10 +19,12 @@
 #define LIGHT_PICK_SHADOW_SLOTS 4
 
 // Samples a point on `light` (chosen with probability pmf) from the path's shading point and, if
-// it can contribute, writes the shadow item. Returns 1 if an item was written.
-INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers* sc,
-                                  const PathBuffers* pb, int path, int light, float pmf, LtRng* rng,
-                                  GLOBAL ShadowItem* out) {
+// it can contribute, writes the shadow item. Returns 1 if an item was written. With use_u, the
+// point on a light with a surface comes from u (the path sampler's light-point dimensions,
+// cl/sampler.h), else from rng.
+INLINE int light_pick_shadow_item_u(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                                    const PathBuffers* pb, int path, int light, float pmf,
+                                    int use_u, float2 u, LtRng* rng, GLOBAL ShadowItem* out) {
   if (!(pmf > 0.0f)) return 0;
   LightPoint lp;
   if (HAS_LIGHT_ENVIRONMENT && IS_LIGHT(&ls->lights[light], LIGHT_ENVIRONMENT)) {
@@ -29,8 +32,8 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
                                      xyz_of(pb->shade_P[path]), rng);
     if (!light_point_from(sc, pb, path, s, &lp)) return 0;
   } else {
-    float u1 = lt_rng_next(rng);
-    float u2 = lt_rng_next(rng);
+    float u1 = use_u ? u.x : lt_rng_next(rng);
+    float u2 = use_u ? u.y : lt_rng_next(rng);
     if (!light_point_sample(ls, sc, pb, path, light, u1, u2, &lp)) return 0;
   }
   float f_w = pb->shade_f[path].w;
@@ -60,14 +63,21 @@ INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers*
   *out = item;
   return 1;
 }
+INLINE int light_pick_shadow_item(const LightSamplerCtx* ls, const SceneBuffers* sc,
+                                  const PathBuffers* pb, int path, int light, float pmf, LtRng* rng,
+                                  GLOBAL ShadowItem* out) {
+  return light_pick_shadow_item_u(ls, sc, pb, path, light, pmf, 0, make_float2(0.0f, 0.0f), rng,
+                                  out);
+}
 
 // The shadow item of `light`, picked with probability pmf for the item's context (a shading point
 // or a medium segment, volume_light.h); returns 1 if it was written.
+// use_u, u: as light_pick_shadow_item_u (shading points only; a segment's streams are its own).
 INLINE int light_pick_items(const LightSamplerCtx* ls, const SceneBuffers* sc,
                             const PathBuffers* pb, int path, int segment, int light, float pmf,
-                            LtRng* rng, GLOBAL ShadowItem* out) {
+                            int use_u, float2 u, LtRng* rng, GLOBAL ShadowItem* out) {
   if (HAS_MEDIUM && segment) return volume_shadow_items(ls, sc, pb, path, light, pmf, rng, out);
-  return light_pick_shadow_item(ls, sc, pb, path, light, pmf, rng, out);
+  return light_pick_shadow_item_u(ls, sc, pb, path, light, pmf, use_u, u, rng, out);
 }
 
 // Distant lights (cl/types.h LIGHT_DISTANT) are sampled beside the light sampler: the root item of
@@ -105,6 +115,13 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
     q = lt_query_point(xyz_of(pb->shade_P[path]), light_query_normal(pb, path));
     seed = float_as_uint_(pb->shade_N[path].w);
   }
+  // sobol (cl/sampler.h): every light sample of a shading point takes its point from the vertex's
+  // light-point dimensions (light_u, drawn once by shade_surface: each light's estimate is
+  // stratified over the pixel's samples), and the root's pick its first word from the
+  // light-selection dimension. The picks below split children and the deeper levels of a descent
+  // draw from their own LtRng streams (a dimension cannot serve choices whose number depends on the
+  // cut, nor a rescaled word keep their exact probabilities); medium segments keep theirs entirely.
+  int strat = !segment && pb->rng[path].w == PATH_SAMPLER_SOBOL;
   const LtTree* t = &ls->tree;
   if (HAS_INFINITE_LIGHT && !segment && it.code == 0 && ls->infinite_count > 0) {
     out.y = light_pick_infinite(ls, sc, pb, path, seed, shadows);
@@ -137,24 +154,31 @@ INLINE int4 light_pick_item(SplitItem it, const LightSamplerCtx* ls, const Scene
       return out;
     }
     // Leaf: every contributing emitter is in the cut with probability 1.
+    float2 u_point = strat ? pb->light_u[path] : make_float2(0.0f, 0.0f);
     int first = lt_leaf_first(it.code);
     for (int j = 0; j < lt_leaf_count(it.code); ++j) {
       if (!(f4_get(imp, j) > 0.0f)) continue;
       int light = t->leaf_lights[first + j];
       LtRng rng = lt_rng_make(seed, 0x80000000u ^ (uint)light);
       out.z += 1;
-      out.y += light_pick_items(ls, sc, pb, path, segment, light, 1.0f, &rng, &shadows[out.y]);
+      out.y += light_pick_items(ls, sc, pb, path, segment, light, 1.0f, strat, u_point, &rng,
+                                &shadows[out.y]);
     }
     return out;
   }
 
   // One stochastic pick below the item (codes are unique within a cut: one stream each).
   LtRng rng = lt_rng_make(seed, (uint)it.code);
+  int root = strat && it.code == 0;
+  uint w = root ? path_sampler_word(pb->rng[path], PATH_DIM_LIGHT_SELECT) : 0u;
   float pmf;
-  int light = light_sampler_pick_q(ls, it.code, &q, &rng, &pmf);
+  int light = light_sampler_pick_w(ls, it.code, &q, root, w, &rng, &pmf);
   out.z += 1;
-  if (light >= 0)
-    out.y += light_pick_items(ls, sc, pb, path, segment, light, pmf, &rng, &shadows[out.y]);
+  if (light >= 0) {
+    float2 u_point = strat ? pb->light_u[path] : make_float2(0.0f, 0.0f);
+    out.y += light_pick_items(ls, sc, pb, path, segment, light, pmf, strat, u_point, &rng,
+                              &shadows[out.y]);
+  }
   return out;
 }
 

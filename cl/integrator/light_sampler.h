@@ -6,10 +6,10 @@
 #ifndef CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 #define CANOPY_INTEGRATOR_LIGHT_SAMPLER_H
 
-#include "../lights/environment.h"
 #include "../light_tree/pmf.h"
 #include "../light_tree/query.h"
 #include "../light_tree/traverse.h"
+#include "../lights/environment.h"
 #include "../types.h"
 
 typedef struct LightSamplerCtx {
@@ -69,20 +69,28 @@ INLINE SplitItem light_sampler_root(const LightSamplerCtx* ls, int path) {
 // each choice with exactly the probability it reports (cl/light_tree/discrete.h, "exact discrete
 // choices"). Returns the light or -1; *pmf its probability. uniform and power ignore q. The host
 // samplers (host/light_tree/light_sampler.cpp) run the same functions.
-INLINE int light_sampler_pick_q(const LightSamplerCtx* ls, int code, const LtQuery* q, LtRng* rng,
-                                float* pmf) {
+// light_sampler_pick_w: with use_w, the pick's first random word is w (the light-selection
+// dimension of the path's sampler, cl/sampler.h), the rest from rng.
+INLINE int light_sampler_pick_w(const LightSamplerCtx* ls, int code, const LtQuery* q, int use_w,
+                                uint w, LtRng* rng, float* pmf) {
   *pmf = 0.0f;
   if (ls->light_count <= 0 || ls->kind == SAMPLER_BSDF) return -1;
   if (ls->kind == SAMPLER_UNIFORM) {
     *pmf = 1.0f / (float)ls->light_count;
-    return (int)lt_rng_index(rng, (uint)ls->light_count);
+    uint w1 = use_w ? w : lt_rng_next_u32(rng);
+    return (int)lt_rng_index_w(w1, rng, (uint)ls->light_count);
   }
   if (ls->kind == SAMPLER_POWER) {
-    int l = lt_alias_pick(ls->alias_prob, ls->alias_index, (uint)ls->light_count, rng);
+    uint w1 = use_w ? w : lt_rng_next_u32(rng);
+    int l = lt_alias_pick_w(ls->alias_prob, ls->alias_index, (uint)ls->light_count, w1, rng);
     *pmf = ls->power_pmf[l];
     return *pmf > 0.0f ? l : -1;
   }
-  return lt_pick_below_q(&ls->tree, code, q, rng, pmf);
+  return lt_pick_below_w(&ls->tree, code, q, use_w, w, rng, pmf);
+}
+INLINE int light_sampler_pick_q(const LightSamplerCtx* ls, int code, const LtQuery* q, LtRng* rng,
+                                float* pmf) {
+  return light_sampler_pick_w(ls, code, q, 0, 0u, rng, pmf);
 }
 INLINE int light_sampler_pick(const LightSamplerCtx* ls, int code, float3 P, float3 N, LtRng* rng,
                               float* pmf) {

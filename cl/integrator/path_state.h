@@ -18,7 +18,10 @@
   X(float4, ray_d)                                                                                 \
   X(float4, throughput) /* xyz: path throughput beta */                                            \
   X(float4, radiance)   /* xyz: radiance gathered so far */                                        \
-  X(uint, rng)          /* PCG state (cl/rng.h) */                                                 \
+  X(uint4, rng)         /* the path's sampler state (cl/sampler.h) */                              \
+  /* sobol (cl/sampler.h): the shading point's light-point numbers, written by shade_surface for */ \
+  /* every light sample of light_pick at that point */                                            \
+  X(float2, light_u)                                                                               \
   X(Hit, hits)          /* closest hit of the current ray */                                       \
   /* The last shading point, kept for light picking in this bounce and for MIS at the next hit. */ \
   /* xyz: position (the ray origin of rays leaving it, offset from the surface, cl/shading.h), */  \

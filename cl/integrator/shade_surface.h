@@ -21,7 +21,7 @@
 #include "../geometry.h"
 #include "../lights/light_sample.h"
 #include "../material_mix.h"
-#include "../rng.h"
+#include "../sampler.h"
 #include "../shading.h"
 #include "../texture.h"
 #include "brdf_mis.h"
@@ -108,8 +108,6 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
     return out;
   }
 
-  PathRng r;
-  r.state = pb->rng[path];
   // A mix is the material it chooses here (the same for every later use of this point).
   const int mat = HAS_MATERIAL_MIX ? material_resolve_mix(sc->materials, prim->material, P_hit, wo,
                                                           sc->texcoords, sc->textures, sc->texels,
@@ -134,12 +132,33 @@ INLINE int2 shade_surface_item(int path, int depth, int max_depth, const SceneBu
   const int two_sided = bsdf_two_sided(&m);
   if (HAS_MATERIAL_DIFFUSE_TRANSMISSION)
     pb->shade_back[path] = f4_from3(offset_ray_origin(P_hit, P_err, -N), two_sided ? 1.0f : 0.0f);
-  uint light_seed = rng_next_u32(&r);
-  float u1 = rng_next_float(&r);
-  float u2 = rng_next_float(&r);
-  float u_rr = rng_next_float(&r);
-  float u3 = rng_next_float(&r);
-  pb->rng[path] = r.state;
+  // The vertex's numbers (cl/sampler.h): the light samplers' seed, the BSDF direction, Russian
+  // roulette, the lobe choice.
+  uint4 ps = pb->rng[path];
+  uint light_seed;
+  float u1, u2, u_rr, u3;
+  if (ps.w == PATH_SAMPLER_SOBOL) {
+    ps.z = sampler_vertex_base(depth); // light_pick reads this vertex's dimensions too
+    light_seed = path_sampler_hash(ps, PATH_DIM_LIGHT_SEED);
+    float2 ub = path_sampler_2d(ps, PATH_DIM_BSDF);
+    u1 = ub.x;
+    u2 = ub.y;
+    // (only where they are read: Russian roulette from depth 2, cl/shading.h; a lobe choice
+    // except on diffuse surfaces)
+    u_rr = depth >= 2 ? path_sampler_1d(ps, PATH_DIM_RR) : 0.0f;
+    u3 = m.type != MATERIAL_DIFFUSE ? path_sampler_1d(ps, PATH_DIM_LOBE) : 0.0f;
+    pb->light_u[path] = path_sampler_2d(ps, PATH_DIM_LIGHT_POINT); // once for the whole cut
+  } else {
+    PathRng r;
+    r.state = ps.x;
+    light_seed = rng_next_u32(&r);
+    u1 = rng_next_float(&r);
+    u2 = rng_next_float(&r);
+    u_rr = rng_next_float(&r);
+    u3 = rng_next_float(&r);
+    ps.x = r.state;
+  }
+  pb->rng[path] = ps;
 
   int last = depth + 1 >= max_depth; // the BSDF ray only looks for emission (see the top)
   // Light shapes are black diffuse: nothing to pick lights for.

@@ -17,7 +17,7 @@
 #ifndef CANOPY_INTEGRATOR_SHADE_VOLUME_H
 #define CANOPY_INTEGRATOR_SHADE_VOLUME_H
 
-#include "../rng.h"
+#include "../sampler.h"
 #include "volume_light.h"
 
 // An unbounded segment (a ray that leaves an unbounded medium) is sampled up to where every
@@ -51,14 +51,30 @@ INLINE int shade_volume_item(int path, int depth, int max_depth, const SceneBuff
       if (f4_get(m.sigma_s, c) > 0.0f) s = fmin(s, f4_get(m.sigma_t, c));
     len = VOLUME_TAIL / s;
   }
-  PathRng r;
-  r.state = pb->rng[path];
-  uint seed = rng_next_u32(&r);
-  float u_free = rng_next_float(&r);
-  float u1 = rng_next_float(&r);
-  float u2 = rng_next_float(&r);
-  float u_rr = rng_next_float(&r);
-  pb->rng[path] = r.state;
+  // The segment's numbers (cl/sampler.h): its light samplers' seed, the free-flight distance,
+  // the phase-function direction, Russian roulette.
+  uint4 ps = pb->rng[path];
+  uint seed;
+  float u_free, u1, u2, u_rr;
+  if (ps.w == PATH_SAMPLER_SOBOL) {
+    ps.z = sampler_vertex_base(depth);
+    seed = path_sampler_hash(ps, PATH_DIM_SEGMENT_SEED);
+    u_free = path_sampler_1d(ps, PATH_DIM_MEDIUM_DISTANCE);
+    float2 up = path_sampler_2d(ps, PATH_DIM_PHASE);
+    u1 = up.x;
+    u2 = up.y;
+    u_rr = depth >= 2 ? path_sampler_1d(ps, PATH_DIM_MEDIUM_RR) : 0.0f; // read from depth 2
+  } else {
+    PathRng r;
+    r.state = ps.x;
+    seed = rng_next_u32(&r);
+    u_free = rng_next_float(&r);
+    u1 = rng_next_float(&r);
+    u2 = rng_next_float(&r);
+    u_rr = rng_next_float(&r);
+    ps.x = r.state;
+  }
+  pb->rng[path] = ps;
   float t_free = medium_sample_distance(&m, u_free);
   int lights = ls->light_count > 0 && ls->kind != SAMPLER_BSDF && len > 0.0f && depth < max_depth;
   pb->seg_o[path] = f4_from3(a, lights ? len : -1.0f);

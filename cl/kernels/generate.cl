@@ -5,16 +5,16 @@
 // render selects the covered pixel (g mod #covered pixels) and the pass (first_pass + g /
 // #covered pixels). The random numbers of a sample are keyed on (seed, film pixel, pass) alone, so
 // the image depends neither on how samples are split into waves nor on the window or sample range a
-// render covers: partial renders merge into the full one.
-#include "rng.h"
+// render covers: partial renders merge into the full one. path_sampler: PATH_SAMPLER_* (sampler.h).
 #include "row_bands.h"
+#include "sampler.h"
 #include "types.h"
 
 __kernel void generate(__global const CameraParams* cam, uint seed, int4 window, int4 bands,
                        uint first_pass, ulong wave_base, int count, __global float4* ray_o,
                        __global float4* ray_d, __global float4* throughput,
-                       __global float4* radiance, __global uint* rng, __global int* ray_queue,
-                       __global int4* path_counts) {
+                       __global float4* radiance, __global uint4* rng, __global int* ray_queue,
+                       __global int4* path_counts, uint path_sampler) {
   int i = get_global_id(0);
   if (i >= count) return;
   ulong g = wave_base + (ulong)i;
@@ -24,17 +24,16 @@ __kernel void generate(__global const CameraParams* cam, uint seed, int4 window,
   uint row = covered_row(bands, in_win / (uint)window.z);
   uint pixel = (uint)(window.y + (int)row) * (uint)cam->width +
                (uint)(window.x + (int)(in_win % (uint)window.z));
-  PathRng r = rng_seed(seed, pixel, pass);
-  float jx = rng_next_float(&r);
-  float jy = rng_next_float(&r);
-  float x = (float)(pixel % (uint)cam->width) + jx;
-  float y = (float)(pixel / (uint)cam->width) + jy;
+  float2 jitter;
+  uint4 state = path_sampler_start(path_sampler, seed, pixel, pass, &jitter);
+  float x = (float)(pixel % (uint)cam->width) + jitter.x;
+  float y = (float)(pixel / (uint)cam->width) + jitter.y;
   float3 d = normalize(cam->lower_left.xyz + cam->du.xyz * x + cam->dv.xyz * y);
   ray_o[i] = (float4)(cam->origin.xyz, 0.0f); // w: tmin
   ray_d[i] = (float4)(d, 0.0f);
   throughput[i] = (float4)(1.0f, 1.0f, 1.0f, 0.0f);
   radiance[i] = (float4)(0.0f);
-  rng[i] = r.state;
+  rng[i] = state;
   ray_queue[i] = i;
   path_counts[i] = (int4)(0); // shadow rays, shading points, camera ray hit an emitter
 }

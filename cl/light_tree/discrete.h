@@ -38,12 +38,17 @@ INLINE uint lt_mulhi(uint a, uint b) {
 // relative n * 2^-64 (< 3e-12 for the format's 5e7 lights, far below the float pmf's own 6e-8).
 // A 24-bit float u could not reach more than 2^24 lights, and u32 * n >> 32 alone would be off by
 // up to n * 2^-32 (1% at 5e7 lights).
-INLINE uint lt_rng_index(LtRng* r, uint n) {
-  uint w1 = lt_rng_next_u32(r); // high word of W
+// lt_rng_index_w: W's high word is w1 (a word of the path's sampler, cl/sampler.h), its low word
+// from r.
+INLINE uint lt_rng_index_w(uint w1, LtRng* r, uint n) {
   uint w0 = lt_rng_next_u32(r);
   uint mid = w1 * n;                              // low half of w1 * n (weight 2^32)
   uint sum = mid + lt_mulhi(w0, n);               // plus the high half of w0 * n
   return lt_mulhi(w1, n) + (sum < mid ? 1u : 0u); // carry into 2^64
+}
+INLINE uint lt_rng_index(LtRng* r, uint n) {
+  uint w1 = lt_rng_next_u32(r); // high word of W
+  return lt_rng_index_w(w1, r, n);
 }
 
 // One 32-bit word w of a uniform U = 0.w1 w2 w3 ... (binary) against a boundary whose scaled value
@@ -81,10 +86,16 @@ INLINE int lt_u_below(uint w, float c, LtRng* r) {
 
 // Alias method (Walker 1977; table by Vose 1991): slot i in [0, n) uniformly, then i itself when
 // U < threshold[i], else alias[i]; the slot and U come from independent words.
-INLINE int lt_alias_pick(GLOBAL const float* threshold, GLOBAL const int* alias, uint n, LtRng* r) {
-  uint slot = lt_rng_index(r, n);
+// lt_alias_pick_w: the slot's first word is w1 (lt_rng_index_w).
+INLINE int lt_alias_pick_w(GLOBAL const float* threshold, GLOBAL const int* alias, uint n, uint w1,
+                           LtRng* r) {
+  uint slot = lt_rng_index_w(w1, r, n);
   uint w = lt_rng_next_u32(r);
   return lt_u_below(w, threshold[slot], r) ? (int)slot : alias[slot];
+}
+INLINE int lt_alias_pick(GLOBAL const float* threshold, GLOBAL const int* alias, uint n, LtRng* r) {
+  uint w1 = lt_rng_next_u32(r);
+  return lt_alias_pick_w(threshold, alias, n, w1, r);
 }
 
 // Probability of lane k: I_k / (sum of the four). 0 if nothing contributes.
@@ -115,7 +126,9 @@ LT_HOT float lt_lane_prob(float4 imp, int k) {
 // has the lane's probability to a few float roundings (relative, < 1e-6) however small it is. The
 // comparisons of U with the boundaries are exact (lt_word_vs: one word, more only on a tie), so
 // no probability is lost to the resolution of U. A lane of importance 0 has an empty interval.
-LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
+// With use_w, U's first word is w (a word of the path's sampler, cl/sampler.h) instead of r's
+// next; the words that resolve a tie still come from r, so U stays uniform to all its bits.
+LT_HOT int lt_choose_lane_w(float4 imp, int use_w, uint w0, LtRng* r) {
   float s = lt_sum4(imp);
   if (!(s > 0.0f) || !is_finite_f(s)) return -1;
   float v0 = imp.x, v1 = imp.y, v2 = imp.z, v3 = imp.w;
@@ -127,7 +140,7 @@ LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
   LT_CSWAP(v1, i1, v2, i2);
   float t2 = v0 + v1;
   float t3 = t2 + v2;
-  uint w = lt_rng_next_u32(r);
+  uint w = use_w ? w0 : lt_rng_next_u32(r);
   // Fast path: U's top 24 bits a (exact as a float) against y_j = c_j * 2^24 (exact scaling of
   // the boundary): U >= c_j if a >= y_j, U < c_j if a + 1 <= y_j; only a boundary strictly
   // inside (a, a + 1) needs the exact 32-bit comparison (probability < 3 * 2^-24 per decision).
@@ -149,6 +162,9 @@ LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
     pos = (o1 == 1) + (o2 == 1) + (o3 == 1);
   }
   return pos == 0 ? i0 : (pos == 1 ? i1 : (pos == 2 ? i2 : i3));
+}
+LT_HOT int lt_choose_lane(float4 imp, LtRng* r) {
+  return lt_choose_lane_w(imp, 0, 0u, r);
 }
 
 #endif // CANOPY_LIGHT_TREE_DISCRETE_H

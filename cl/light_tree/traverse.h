@@ -5,10 +5,10 @@
 #define CANOPY_LIGHT_TREE_TRAVERSE_H
 
 #include "../compat.h"
+#include "discrete.h"
 #include "importance.h"
 #include "layout.h"
 #include "query.h"
-#include "discrete.h"
 
 // Prefetches the records of the children of a node that the next step may read: node records
 // and child codes of its child nodes, emitter records of its leaves.
@@ -33,14 +33,20 @@ LT_HOT void lt_prefetch_children(const LtTree* t, int4 ch) {
 // (a shading point, §5.1, or a ray segment in a medium, §5.2), each decision from fresh words of
 // `rng` (lt_choose_lane). Returns the light index, or -1 if nothing below `code` contributes;
 // *prob = product of the lane probabilities taken below `code`.
-INLINE int lt_pick_below_q(const LtTree* t, int code, const LtQuery* q, LtRng* rng, float* prob) {
+// With use_w, the first decision's first word is w (a word of the path's sampler, cl/sampler.h:
+// the decision among the root's lanes is then stratified over a pixel's samples); the rest of the
+// descent draws fresh words, since a rescaled word would not keep every choice's exact
+// probability (discrete.h).
+INLINE int lt_pick_below_w(const LtTree* t, int code, const LtQuery* q, int use_w, uint w,
+                           LtRng* rng, float* prob) {
   float p = 1.0f;
   *prob = 0.0f;
   while (code >= 0) {
     int4 ch = t->children[code];
     lt_prefetch_children(t, ch);
     float4 imp = lt_node_importance_q(t, code, q, 1);
-    int lane = lt_choose_lane(imp, rng);
+    int lane = lt_choose_lane_w(imp, use_w, w, rng);
+    use_w = 0;
     if (lane < 0) return -1;
     p = p * lt_lane_prob(imp, lane);
     code = i4_get(ch, lane);
@@ -55,11 +61,14 @@ INLINE int lt_pick_below_q(const LtTree* t, int code, const LtQuery* q, LtRng* r
     LT_PREFETCH((GLOBAL const float4*)L + 5);
   }
   float4 imp = lt_leaf_importance_q(t, code, q, 1);
-  int lane = lt_choose_lane(imp, rng);
+  int lane = lt_choose_lane_w(imp, use_w, w, rng);
   if (lane < 0) return -1;
   p = p * lt_lane_prob(imp, lane);
   *prob = p;
   return (int)float_as_uint_(rec[lane * LT_EMITTER_F4 + 1].w); // = leaf_lights[first + lane]
+}
+INLINE int lt_pick_below_q(const LtTree* t, int code, const LtQuery* q, LtRng* rng, float* prob) {
+  return lt_pick_below_w(t, code, q, 0, 0u, rng, prob);
 }
 
 // The descent for a shading point P with unit normal N (0: none).

@@ -49,6 +49,7 @@ struct ConvergeArgs {
   double clamp = 0.0; // > 0: clamp render and reference to [0, clamp] before measuring
   int reference_spp = 0;
   std::string reference_sampler = "exhaustive";
+  std::string path_sampler{kDefaultPathSampler}; // --sampler
   uint32_t reference_seed = 1000003;
 };
 
@@ -70,6 +71,9 @@ struct SamplerConfig {
   // at its midpoint (the ablation of Conty Estevez & Kulla's segment importance, Eq. 7).
   bool volume_midpoint = false;
   int max_cut = kDefaultMaxCut; // "/maxcut=N": tree-split's cut cap per shading point
+  // The camera paths' numbers (RendererOptions::path_sampler): --sampler, or "/sobol",
+  // "/independent".
+  std::string path_sampler{kDefaultPathSampler};
 };
 
 constexpr std::string_view kNoOrientSuffix = "-noorient";
@@ -145,9 +149,10 @@ double seconds_since(Clock::time_point t0) {
 
 // `scene` gives the defaults: the tree's split threshold and the BRDF samplers' settings.
 SamplerConfig parse_config(const std::string& text, const IntegratorSettings& scene,
-                           const std::string& option) {
+                           const std::string& option, const std::string& path_sampler) {
   SamplerConfig c;
   c.label = text;
+  c.path_sampler = path_sampler;
   c.threshold = scene.split_threshold;
   c.brdf.delta = scene.brdf_delta;
   c.brdf.n_max = scene.brdf_n_max;
@@ -155,7 +160,7 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
   c.brdf.adaptive = true;
   c.max_cut = scene.max_cut;
   std::string spec = text;
-  bool equal = false, split_set = false, nmax_set = false, cut_set = false;
+  bool equal = false, split_set = false, nmax_set = false, cut_set = false, path_set = false;
   // The integer after "/name=", in [lo, hi].
   auto suffix_int = [&](const std::string& suffix, std::string_view name, long lo, long hi) {
     std::string t = suffix.substr(name.size());
@@ -175,6 +180,10 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
       any = true;
       if (suffix == kNoMisSuffix && c.mis) {
         c.mis = false;
+      } else if (!path_set && std::find(kPathSamplerNames.begin(), kPathSamplerNames.end(),
+                                        suffix) != kPathSamplerNames.end()) {
+        c.path_sampler = suffix; // "/sobol", "/independent": the camera paths' numbers
+        path_set = true;
       } else if (suffix == kEqualSuffix && !equal) {
         equal = true;
       } else if (suffix == kMidpointSuffix && !c.volume_midpoint) {
@@ -202,7 +211,8 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
         throw SceneError(fmt::format("{}: '{}': unknown or repeated suffix '/{}' (/{}: MIS off; "
                                      "/{}: brdf-mis with equal allocation; /{}: medium segments "
                                      "ranked at their midpoint; /{}T: split threshold T; "
-                                     "/{}N: brdf-mis' N_max; /{}N: cut cap)",
+                                     "/{}N: brdf-mis' N_max; /{}N: cut cap; /sobol, "
+                                     "/independent: the path sampler)",
                                      option, printable(text, 256), printable(suffix, 256),
                                      kNoMisSuffix, kEqualSuffix, kMidpointSuffix, kSplitSuffix,
                                      kNmaxSuffix, kMaxCutSuffix));
@@ -213,7 +223,7 @@ SamplerConfig parse_config(const std::string& text, const IntegratorSettings& sc
           fmt::format("{}: '{}': empty suffix after '/'", option, printable(text, 256)));
   }
   if (spec == kAutoLightSampler) { // chosen per scene by a pilot (render/auto_sampler.h)
-    if (spec != text)
+    if (spec != text && !(path_set && text == spec + "/" + c.path_sampler))
       throw SceneError(fmt::format("{}: '{}': auto takes no suffix", option, printable(text, 256)));
     c.sampler = spec;
     return c;
@@ -271,16 +281,18 @@ RendererOptions renderer_options(const SamplerConfig& c) {
   opt.orientation_term = c.orientation;
   opt.mis = c.mis;
   opt.brdf = c.brdf;
+  opt.path_sampler = c.path_sampler;
   // auto: the first candidate; the pilot then switches
   return c.sampler == kAutoLightSampler ? auto_candidates(opt).front().options : opt;
 }
 
-std::vector<SamplerConfig> parse_configs(const std::string& list, const IntegratorSettings& scene) {
+std::vector<SamplerConfig> parse_configs(const std::string& list, const IntegratorSettings& scene,
+                                         const std::string& path_sampler) {
   std::vector<SamplerConfig> out;
   std::stringstream ss(list);
   std::string item;
   while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(parse_config(item, scene, "--samplers"));
+    if (!item.empty()) out.push_back(parse_config(item, scene, "--samplers", path_sampler));
   if (out.empty()) throw SceneError("--samplers: no sampler given");
   return out;
 }
@@ -475,7 +487,8 @@ fs::path mask_path(const std::string& reference) {
 // emitter pixel when a camera ray of either half hit an emitter: the reference's many samples
 // make it the most complete) goes to REF.mask.png, so a reused reference keeps it.
 void render_reference(ClRuntime& rt, const Scene& base, const ConvergeArgs& a, Progress& progress) {
-  SamplerConfig c = parse_config(a.reference_sampler, base.integrator, "--reference-sampler");
+  SamplerConfig c =
+      parse_config(a.reference_sampler, base.integrator, "--reference-sampler", a.path_sampler);
   Scene scene = base;
   scene.integrator.volume_importance = c.volume_midpoint ? "midpoint" : "segment";
   Renderer r(rt, scene, renderer_options(c));
@@ -674,7 +687,7 @@ int run_converge(const ConvergeArgs& a) {
   Scene base = load_scene(a.scene);
   if (a.film_scale != 1.0) scale_film(base.film, a.film_scale);
   if (a.max_depth > 0) base.integrator.max_depth = a.max_depth;
-  std::vector<SamplerConfig> configs = parse_configs(a.samplers, base.integrator);
+  std::vector<SamplerConfig> configs = parse_configs(a.samplers, base.integrator, a.path_sampler);
   if (a.spp_factor < 2) throw SceneError("--spp-factor: must be >= 2");
   if (a.reference_spp > 0 && a.reference_time > 0.0)
     throw SceneError("--reference-spp and --reference-time: give one of them");
@@ -1059,6 +1072,10 @@ CLI::App* add_converge_command(CLI::App& app, std::function<int()>& action) {
                   "Render the reference first, its spp chosen by timing renders so that it takes "
                   "about this many seconds (overwrites --reference)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--sampler", a->path_sampler,
+                  "The camera paths' numbers of every configuration without a /sobol or "
+                  "/independent suffix: sobol (default) or independent")
+      ->check(CLI::IsMember({"sobol", "independent"}));
   cmd->add_option("--reference-sampler", a->reference_sampler,
                   "Configuration of the reference, as in --samplers: preferably an estimator "
                   "other than the ones judged, else at >= 64x their spp")

@@ -1,6 +1,7 @@
 // canopy: the command-line front end.
 //   canopy render SCENE [--spp N] [--out FILE.exr] [--png FILE.png] [--seed S]
-//                       [--light-sampler NAME] [--no-mis] [--device NAME]
+//                       [--light-sampler NAME] [--sampler independent|sobol] [--no-mis]
+//                       [--device NAME]
 //   canopy info
 //   canopy compare A.exr B.exr      (cli/compare_command.cpp)
 //   canopy converge SCENE ...       (cli/converge_command.cpp)
@@ -49,6 +50,7 @@ struct RenderArgs {
   std::optional<int> spp;
   std::optional<uint32_t> seed;
   std::optional<std::string> light_sampler;
+  std::string path_sampler{kDefaultPathSampler};
   std::optional<float> split_threshold;
   std::optional<int> max_cut;
   std::optional<int> max_depth;
@@ -276,6 +278,10 @@ int run_render(const RenderArgs& args) {
   PixelWindow window;
   if (args.crop) window = parse_crop(*args.crop, scene.film.width, scene.film.height);
   if (args.seed) scene.integrator.seed = *args.seed;
+  if (std::find(kPathSamplerNames.begin(), kPathSamplerNames.end(), args.path_sampler) ==
+      kPathSamplerNames.end())
+    throw SceneError(fmt::format("--sampler: '{}': must be independent or sobol",
+                                 printable(args.path_sampler, 256)));
   if (args.light_sampler) scene.integrator.light_sampler = *args.light_sampler;
   if (args.split_threshold) scene.integrator.split_threshold = *args.split_threshold;
   if (args.max_cut) {
@@ -357,6 +363,7 @@ int run_render(const RenderArgs& args) {
   ropt.max_cut = scene.integrator.max_cut;
   ropt.orientation_term = !args.no_orientation;
   ropt.mis = scene.integrator.mis;
+  ropt.path_sampler = args.path_sampler;
   ropt.brdf.delta = scene.integrator.brdf_delta;
   ropt.brdf.n_max = scene.integrator.brdf_n_max;
   ropt.brdf.lambda = scene.integrator.brdf_lambda;
@@ -433,6 +440,7 @@ int run_render(const RenderArgs& args) {
        {"canopy:max_depth", std::to_string(scene.integrator.max_depth)},
        {"canopy:orientation_term", args.no_orientation ? "off" : "on"},
        {"canopy:mis", scene.integrator.mis ? "on" : "off"},
+       {"canopy:sampler", args.path_sampler},
        {"canopy:spp", std::to_string(scene.integrator.spp)},
        {"canopy:auto", choice ? describe(*choice) : std::string("off")}});
   write_png(png, img);
@@ -493,6 +501,7 @@ int run_render(const RenderArgs& args) {
     j["max_cut"] = scene.integrator.max_cut;
     j["max_depth"] = scene.integrator.max_depth;
     j["mis"] = scene.integrator.mis;
+    j["sampler"] = args.path_sampler;
     j["brdf_delta"] = scene.integrator.brdf_delta;
     j["brdf_n_max"] = scene.integrator.brdf_n_max;
     j["brdf_lambda"] = scene.integrator.brdf_lambda;
@@ -564,6 +573,9 @@ int main(int argc, char** argv) {
                      "file in the same directory, then renamed");
   render->add_option("--png", rargs.png, "Output PNG (default: the EXR path with .png)");
   render->add_option("--seed", rargs.seed, "Random seed (overrides the scene)");
+  render->add_option("--sampler", rargs.path_sampler,
+                     "The camera paths' numbers: sobol (Owen-scrambled Sobol points, stratified "
+                     "per pixel) or independent (a PCG stream per path); default sobol");
   render->add_option("--light-sampler", rargs.light_sampler, "Light sampler (overrides the scene)")
       ->check(CLI::IsMember(
           std::vector<std::string>(kLightSamplerChoices.begin(), kLightSamplerChoices.end())));

@@ -4,6 +4,7 @@
 #include "integrator/light_pick.h"
 #include "render/camera.h"
 #include "render/memory_budget.h"
+#include "sampler.h"
 
 #include <fmt/format.h>
 
@@ -39,6 +40,13 @@ constexpr int kCutBins = 65;
 
 const std::vector<std::string>& wavefront_kernel_files() {
   return kKernelFiles;
+}
+
+uint32_t path_sampler_id(std::string_view name) {
+  if (name == kPathSamplerNames[PATH_SAMPLER_INDEPENDENT]) return PATH_SAMPLER_INDEPENDENT;
+  if (name == kPathSamplerNames[PATH_SAMPLER_SOBOL]) return PATH_SAMPLER_SOBOL;
+  throw std::invalid_argument(fmt::format("unknown path sampler '{}' (independent or sobol)",
+                                          std::string(name.substr(0, 256))));
 }
 
 int emission_scale_exponent(const std::vector<Light>& lights) {
@@ -152,6 +160,7 @@ Renderer::Renderer(ClRuntime& rt, Scene& scene, const RendererOptions& options)
     throw ClError(fmt::format("device {} has no double precision (cl_khr_fp64), which the film "
                               "accumulation needs; choose another device with --device",
                               rt.device_name()));
+  path_sampler_id(options.path_sampler); // a known name
   auto t0 = Clock::now();
   for (const MaterialDesc& m : scene.materials)
     materials_.push_back(m.gpu);
@@ -263,6 +272,7 @@ void Renderer::reset_render_stats() {
 void Renderer::set_light_sampler(const RendererOptions& options) {
   auto t0 = Clock::now();
   // The geometry, textures and the rest stay; only the sampler's data and the kernels change.
+  path_sampler_id(options.path_sampler); // a known name
   options_ = options;
   release_buffers(); // sized for the previous sampler
   LightTree previous = std::move(sampler_.tree);
@@ -339,6 +349,7 @@ Film Renderer::render(const RenderSettings& settings) {
   device_.set_args(args);
   args.set("cam", camera_);
   args.set("seed", cl_uint(settings.seed));
+  args.set("path_sampler", cl_uint(path_sampler_id(options_.path_sampler)));
   args.set("window", make_int4(win.x0, win.y0, width, height));
   args.set("bands", bands.packed());
   args.set("first_pass", cl_uint(settings.first_sample));

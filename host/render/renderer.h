@@ -14,10 +14,12 @@
 #include "row_bands.h"
 #include "scene/scene.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -124,6 +126,12 @@ struct RenderSettings {
   std::function<void(double fraction)> progress; // optional, called after each wave
 };
 
+// The path samplers by their PATH_SAMPLER_* value (cl/sampler.h).
+inline constexpr std::array<std::string_view, 2> kPathSamplerNames = {"independent", "sobol"};
+inline constexpr std::string_view kDefaultPathSampler = "sobol";
+// The PATH_SAMPLER_* value of a name of kPathSamplerNames; throws std::invalid_argument otherwise.
+uint32_t path_sampler_id(std::string_view name);
+
 struct RendererOptions {
   // The library's baseline for code that builds a renderer directly (the tests); the product's
   // default is the scene's (IntegratorSettings::light_sampler, "auto": render/auto_sampler.h).
@@ -135,6 +143,10 @@ struct RendererOptions {
   BrdfSettings brdf;                  // brdf-mis, brdf-oriented
   bool all_features = false;          // compile every kernel feature (tests)
   size_t split_queue_items = 1 << 20; // split-queue capacity per wave
+  // The camera paths' numbers (cl/sampler.h): "independent" (a PCG stream per path) or "sobol"
+  // (Owen-scrambled Sobol points per purpose); a name of kPathSamplerNames. The library's
+  // baseline; the CLI's default is kDefaultPathSampler.
+  std::string path_sampler = "independent";
 };
 
 // The kernel sources of the wavefront, in build order.
