@@ -149,6 +149,8 @@ private:
   // A texture input of an operator texture or a material: the texture a parameter names or its
   // constant value (`def` where absent).
   NamedTexture texture_input(Params& p, std::string_view name, bool is_float, float3 def);
+  // A 2D texture's uv mapping (uscale, vscale, udelta, vdelta); other mappings are warned about.
+  float4 uv_mapping(const Loc& loc, Params& p);
   // pbrt-v4's checkerboard, mix and scale textures (textures.cpp).
   NamedTexture operator_texture(const Loc& loc, Params& p, const std::string& name,
                                 const std::string& cls, bool is_float);

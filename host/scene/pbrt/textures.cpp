@@ -105,6 +105,24 @@ void Reader::texture(const Token& d, Params& p, const std::string& name, const s
   named[name] = std::move(t);
 }
 
+float4 Reader::uv_mapping(const Loc& loc, Params& p) {
+  std::string mapping = p.get_string("mapping").value_or("uv");
+  if (mapping != "uv") {
+    warn(p.find("mapping")->loc,
+         fmt::format("{}: \"string mapping\" \"{}\": only \"uv\" mapping is supported (uv used), "
+                     "ignored",
+                     p.what(), printable(mapping)));
+    for (const char* planar : {"v1", "v2"}) // the planar mapping's vectors
+      p.find(planar);
+  }
+  double uvm[4] = {p.get_float("uscale", 1.0), p.get_float("vscale", 1.0),
+                   p.get_float("udelta", 0.0), p.get_float("vdelta", 0.0)};
+  for (double x : uvm)
+    if (!std::isfinite(float(x)))
+      fail(loc, fmt::format("{}: uscale, vscale, udelta, vdelta: a value is too large", p.what()));
+  return make_float4(float(uvm[0]), float(uvm[1]), float(uvm[2]), float(uvm[3]));
+}
+
 NamedTexture Reader::texture_input(Params& p, std::string_view name, bool is_float, float3 def) {
   NamedTexture c;
   c.kind = K::Constant;
@@ -166,22 +184,7 @@ NamedTexture Reader::operator_texture(const Loc& loc, Params& p, const std::stri
   NamedTexture a = texture_input(p, "tex1", is_float, one),
                b = texture_input(p, "tex2", is_float, zero);
   if (a.kind == K::Unsupported || b.kind == K::Unsupported) return t;
-  std::string mapping = p.get_string("mapping").value_or("uv");
-  if (mapping != "uv") {
-    warn(p.find("mapping")->loc,
-         fmt::format("{}: \"string mapping\" \"{}\": only \"uv\" mapping is supported (uv used), "
-                     "ignored",
-                     p.what(), printable(mapping)));
-    for (const char* planar : {"v1", "v2"}) // the planar mapping's vectors
-      p.find(planar);
-  }
-  double uvm[4] = {p.get_float("uscale", 1.0), p.get_float("vscale", 1.0),
-                   p.get_float("udelta", 0.0), p.get_float("vdelta", 0.0)};
-  for (double x : uvm)
-    if (!std::isfinite(float(x)))
-      fail(loc, fmt::format("{}: uscale, vscale, udelta, vdelta: a value is too large", p.what()));
-  return compose(TEXTURE_CHECKERBOARD, {{&a, is_float}, {&b, is_float}},
-                 make_float4(float(uvm[0]), float(uvm[1]), float(uvm[2]), float(uvm[3])));
+  return compose(TEXTURE_CHECKERBOARD, {{&a, is_float}, {&b, is_float}}, uv_mapping(loc, p));
 }
 
 NamedTexture Reader::scaled_texture(const Loc& loc, const NamedTexture& t, float k, bool is_float) {
@@ -279,21 +282,7 @@ NamedTexture Reader::image_texture(const Loc& loc, Params& p, const std::string&
          fmt::format("{}: \"string filter\" \"{}\"{}: Canopy filters bilinearly, ignored", p.what(),
                      printable(filter),
                      p.find("maxanisotropy") ? fmt::format(" (maxanisotropy {})", aniso) : ""));
-  std::string mapping = p.get_string("mapping").value_or("uv");
-  if (mapping != "uv") {
-    warn(p.find("mapping")->loc,
-         fmt::format("{}: \"string mapping\" \"{}\": only \"uv\" mapping is supported (uv used), "
-                     "ignored",
-                     p.what(), printable(mapping)));
-    for (const char* planar : {"v1", "v2"}) // the planar mapping's vectors
-      p.find(planar);
-  }
-  double uvm[4] = {p.get_float("uscale", 1.0), p.get_float("vscale", 1.0),
-                   p.get_float("udelta", 0.0), p.get_float("vdelta", 0.0)};
-  for (double x : uvm)
-    if (!std::isfinite(float(x)))
-      fail(loc, fmt::format("{}: uscale, vscale, udelta, vdelta: a value is too large", p.what()));
-  td.uvmap = make_float4(float(uvm[0]), float(uvm[1]), float(uvm[2]), float(uvm[3]));
+  td.uvmap = uv_mapping(loc, p);
   return t;
 }
 
