@@ -363,6 +363,31 @@ TEST(AutoSampler, AHeavyTailSceneIsRankedCorrectly) {
   }
 }
 
+// A candidate explored on bands of rows is compared with the others over its rows only: on the
+// default scene (the ceiling's lights in the top rows, a dim floor below) its image mean over its
+// bands is far from the film's, and the missed-tail test must not take that for a missed tail.
+TEST(AutoSampler, ACandidateOnBandsIsComparedOverItsRows) {
+  Scene scene = load_scene(std::string(CANOPY_SCENES_DIR) + "/default.json");
+  scene.film.width = 128;
+  scene.film.height = 128;
+  scene.integrator.max_depth = 1;
+  ClRuntime rt;
+  RendererOptions base = auto_candidates(RendererOptions{}).front().options;
+  base.split_queue_items = 1 << 14; // waves of 256 paths: the splitting candidate explores bands
+  Renderer renderer(rt, scene, base);
+  for (uint32_t seed = 1; seed <= 3; ++seed) {
+    RenderSettings rs;
+    rs.spp = 24;
+    rs.seed = seed;
+    AutoRender r = render_auto(renderer, base, rs, 4);
+    ASSERT_EQ(r.choice.candidates.size(), 3u);
+    const PilotResult& banded = r.choice.candidates[2];
+    ASSERT_DOUBLE_EQ(banded.explored_share, 0.25);
+    EXPECT_FALSE(banded.missed_tail) << describe(r.choice);
+    EXPECT_GT(banded.weight[0] + banded.weight[1], 0.0) << describe(r.choice);
+  }
+}
+
 // Too few samples to explore (1 or 2 spp): tree renders it all, bit for bit its own render.
 TEST(AutoSampler, WithoutRoomToExploreTreeRenders) {
   AutoRun run(kGridJson);

@@ -348,17 +348,27 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   }
   choice.explored_samples = next - settings.first_sample;
 
-  // Measurements over the film and over each half; the emitter mask is the union of every
-  // candidate's (the same pixels for all).
-  std::vector<uint8_t> emitter(films[0].sum.size(), 0);
-  for (const Film& f : films)
-    for (size_t p = 0; p < emitter.size(); ++p)
+  // Measurements over the film and over each half. The image means compare over the same pixels:
+  // those no candidate's camera rays saw an emitter at, and that every candidate explored (a
+  // banded candidate's rows show another part of the image than the film's mean); on interleaved
+  // rows, where no pixel is common, each over its own rows.
+  std::vector<uint8_t> emitter(films[0].sum.size(), 0), off_mean(emitter.size(), 0);
+  bool any_common = false;
+  for (size_t p = 0; p < emitter.size(); ++p) {
+    bool common = true;
+    for (const Film& f : films) {
       emitter[p] |= f.counts[p].z > 0.0 ? 1 : 0;
+      common = common && f.sum[p].w > 1.0;
+    }
+    any_common = any_common || common;
+    off_mean[p] = emitter[p] || !common;
+  }
+  if (!any_common) off_mean = emitter;
   std::vector<ExploreStats> halves[2];
   for (size_t i = 0; i < cand.size(); ++i) {
-    cand[i].stats = explore_stats(films[i], emitter, -1);
+    cand[i].stats = explore_stats(films[i], off_mean, -1);
     for (int h = 0; h < 2; ++h)
-      halves[h].push_back(explore_stats(films[i], emitter, h));
+      halves[h].push_back(explore_stats(films[i], off_mean, h));
   }
   // Half h's samples are weighted by the other half's measurements.
   for (int h = 0; h < 2; ++h) {

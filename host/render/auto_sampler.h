@@ -38,8 +38,9 @@ struct ExploreStats {
 };
 
 // A candidate's measurements from its film: over the pixels of the film's half `half` (0 or 1, a
-// checkerboard of 8 x 8 tiles over the film) or over all (-1). `emitter` marks the pixels whose
-// camera rays saw an emitter (in any candidate's samples).
+// checkerboard of 8 x 8 tiles over the film) or over all (-1). `emitter` marks the pixels left out
+// of the image mean: those whose camera rays saw an emitter (in any candidate's samples), or that
+// not every candidate explored.
 ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half);
 
 struct PilotResult {
