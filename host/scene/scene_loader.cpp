@@ -332,6 +332,24 @@ Medium parse_medium(const JsonValue& v, double3 origin) {
 }
 
 // An image texture given for a material's "albedo" (channels 3) or "roughness" (channels 1):
+// A 2D texture's "uv_scale" and "uv_offset" (pairs of numbers) into uvmap's (x, y) and (z, w).
+void read_uv_mapping(const JsonObject& o, float4* uvmap) {
+  auto pair = [](const JsonValue& a) {
+    if (!a.is_array() || a.array_size() != 2) a.fail("must be an array of 2 numbers");
+    return make_float2(a.at(0).as_float(), a.at(1).as_float());
+  };
+  if (auto sv = o.get("uv_scale")) {
+    float2 k = pair(*sv);
+    uvmap->x = k.x;
+    uvmap->y = k.y;
+  }
+  if (auto ov = o.get("uv_offset")) {
+    float2 d = pair(*ov);
+    uvmap->z = d.x;
+    uvmap->w = d.y;
+  }
+}
+
 // {"texture": file, "scale", "wrap", "encoding", "uv_scale", "uv_offset"} (docs/scene-format.md,
 // Textures).
 TextureDesc parse_texture(const JsonValue& v, const Builder& b, int channels) {
@@ -372,20 +390,7 @@ TextureDesc parse_texture(const JsonValue& v, const Builder& b, int channels) {
                                : (e == "srgb" ? ImageEncoding::Srgb : ImageEncoding::Linear);
     }
   }
-  auto pair = [](const JsonValue& a) {
-    if (!a.is_array() || a.array_size() != 2) a.fail("must be an array of 2 numbers");
-    return make_float2(a.at(0).as_float(), a.at(1).as_float());
-  };
-  if (auto sv = o.get("uv_scale")) {
-    float2 k = pair(*sv);
-    t.uvmap.x = k.x;
-    t.uvmap.y = k.y;
-  }
-  if (auto ov = o.get("uv_offset")) {
-    float2 d = pair(*ov);
-    t.uvmap.z = d.x;
-    t.uvmap.w = d.y;
-  }
+  read_uv_mapping(o, &t.uvmap);
   return t;
 }
 
@@ -424,20 +429,7 @@ int parse_texture_nodes(const JsonValue& v, const Builder& b, int channels,
     root.kind = TEXTURE_CHECKERBOARD;
     input(o.req("tex1"), channels, 0);
     input(o.req("tex2"), channels, 1);
-    auto pair = [](const JsonValue& a) {
-      if (!a.is_array() || a.array_size() != 2) a.fail("must be an array of 2 numbers");
-      return make_float2(a.at(0).as_float(), a.at(1).as_float());
-    };
-    if (auto sv = o.get("uv_scale")) {
-      float2 k = pair(*sv);
-      root.uvmap.x = k.x;
-      root.uvmap.y = k.y;
-    }
-    if (auto ov = o.get("uv_offset")) {
-      float2 d = pair(*ov);
-      root.uvmap.z = d.x;
-      root.uvmap.w = d.y;
-    }
+    read_uv_mapping(o, &root.uvmap);
   } else if (type == "mix") {
     o.allow({"type", "tex1", "tex2", "amount"});
     root.kind = TEXTURE_MIX;
