@@ -69,14 +69,6 @@ Material plastic(float alpha) {
 Material diffuse() {
   return make_diffuse(make_float3(0.8f, 0.5f, 0.2f));
 }
-// Diffuse transmission (pbrt-v4's defaults, and a coloured one that mostly transmits).
-Material transmitter(float3 r, float3 t) {
-  Material m{};
-  m.type = MATERIAL_DIFFUSE_TRANSMISSION;
-  m.albedo = f4_from3(r, 0.0f);
-  m.specular = f4_from3(t, 0.0f);
-  return m;
-}
 
 struct Probes {
   std::vector<Material> mats;
@@ -253,9 +245,11 @@ void run_probes(ClRuntime& rt, const std::string& options, const std::vector<Mat
 }
 
 std::vector<Material> all_materials() {
-  std::vector<Material> v = {
-      diffuse(), transmitter(make_float3(0.25f, 0.25f, 0.25f), make_float3(0.25f, 0.25f, 0.25f)),
-      transmitter(make_float3(0.1f, 0.3f, 0.2f), make_float3(0.8f, 0.6f, 0.7f))};
+  std::vector<Material> v = {diffuse(),
+                             test::make_diffuse_transmission(make_float3(0.25f, 0.25f, 0.25f),
+                                                             make_float3(0.25f, 0.25f, 0.25f)),
+                             test::make_diffuse_transmission(make_float3(0.1f, 0.3f, 0.2f),
+                                                             make_float3(0.8f, 0.6f, 0.7f))};
   for (float a : {0.0f, 1e-4f, 0.01f, 0.09f, 1.0f}) {
     v.push_back(conductor(a));
     v.push_back(plastic(a));

@@ -10,6 +10,8 @@
 #include "material_mix.h"
 #include "texture.h"
 
+#include "support/materials.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -53,14 +55,6 @@ Material mix(int a, int b, float amount) {
   m.mix_material[0] = a;
   m.mix_material[1] = b;
   m.mix_amount = amount;
-  return m;
-}
-
-Material transmitter(float3 r, float3 t) {
-  Material m{};
-  m.type = MATERIAL_DIFFUSE_TRANSMISSION;
-  m.albedo = f4_from3(r, 0.0f);
-  m.specular = f4_from3(t, 0.0f);
   return m;
 }
 
@@ -135,7 +129,8 @@ TEST(TextureNodes, MixLerpsAndScaleMultiplies) {
   EXPECT_FLOAT_EQ(mt.albedo.x, 0.8f);
   EXPECT_FLOAT_EQ(mt.albedo.y, 1.0f);
   // The transmittance texture replaces `specular`.
-  Material dt = transmitter(make_float3(0.1f, 0.1f, 0.1f), make_float3(0, 0, 0));
+  Material dt =
+      canopy::test::make_diffuse_transmission(make_float3(0.1f, 0.1f, 0.1f), make_float3(0, 0, 0));
   dt.transmittance_texture = 3;
   material_apply_textures(&dt, uv.data(), s.data(), nullptr, 0, 0.2f, 0.3f);
   EXPECT_FLOAT_EQ(dt.specular.x, 0.6f);
@@ -212,7 +207,8 @@ TEST(MixMaterial, TexturedAmountIsReadAtTheHit) {
 
 // ---------------------------------------------------------------- diffuse transmission
 TEST(DiffuseTransmission, EvalIsRoverPiAboveAndToverPiBelow) {
-  Material m = transmitter(make_float3(0.3f, 0.2f, 0.1f), make_float3(0.5f, 0.6f, 0.7f));
+  Material m = canopy::test::make_diffuse_transmission(make_float3(0.3f, 0.2f, 0.1f),
+                                                       make_float3(0.5f, 0.6f, 0.7f));
   float3 wo = normalize(make_float3(0.3f, -0.2f, 0.9f));
   float3 up = normalize(make_float3(-0.5f, 0.1f, 0.4f)), down = make_float3(up.x, up.y, -up.z);
   float3 r = bsdf_eval(&m, wo, up), t = bsdf_eval(&m, wo, down);
@@ -234,7 +230,7 @@ TEST(DiffuseTransmission, EvalIsRoverPiAboveAndToverPiBelow) {
 // returns exactly what it receives); the pdf integrates to 1 over the sphere (uniform directions).
 TEST(DiffuseTransmission, SamplingMatchesEvalAndConservesEnergy) {
   const float3 R = make_float3(0.3f, 0.5f, 0.1f), T = make_float3(0.7f, 0.2f, 0.4f);
-  Material m = transmitter(R, T);
+  Material m = canopy::test::make_diffuse_transmission(R, T);
   std::mt19937 gen(11);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   const int n = 400000;
@@ -274,7 +270,8 @@ TEST(DiffuseTransmission, SamplingMatchesEvalAndConservesEnergy) {
   }
   EXPECT_NEAR(integral * 4.0 * kPi / m_dirs, 1.0, 0.01);
   // Black: nothing sampled, nothing evaluated.
-  Material black = transmitter(make_float3(0, 0, 0), make_float3(0, 0, 0));
+  Material black =
+      canopy::test::make_diffuse_transmission(make_float3(0, 0, 0), make_float3(0, 0, 0));
   BsdfSample s = bsdf_sample(&black, wo, make_float3(0.3f, 0.4f, 0.5f));
   EXPECT_EQ(s.weight.x, 0.0f);
   EXPECT_EQ(bsdf_pdf(&black, wo, make_float3(0, 0, 1)), 0.0f);

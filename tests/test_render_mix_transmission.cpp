@@ -47,14 +47,6 @@ Light point_light(float3 p, float3 I) {
   return l;
 }
 
-// The 2 x 2 plane with uv = ((x + 1) / 2, (y + 1) / 2).
-Scene uv_plane(MaterialDesc m, int size) {
-  Scene s = test::lit_plane_scene(std::move(m), 20.0f, 1.0f, size, size);
-  s.triangle_uvs = {make_float2(0, 0), make_float2(1, 0), make_float2(1, 1),
-                    make_float2(0, 0), make_float2(1, 1), make_float2(0, 1)};
-  return s;
-}
-
 // Pixel p's mean and the standard error of its red channel (k = 0), green (1) or blue (2).
 void pixel_stats(const Film& f, size_t p, int k, double* mean, double* se) {
   const double n = f.sum[p].w;
@@ -114,7 +106,7 @@ TEST(RenderMix, CheckerboardSquaresAreExactUnderTheSun) {
   const float cos_t = -normalize(travel).z;
   MaterialDesc m = diffuse_material("checks", make_float3(0, 0, 0));
   m.gpu.albedo_texture = 3;
-  Scene scene = uv_plane(m, 40);
+  Scene scene = test::uv_plane_scene(m, 40);
   scene.textures = {constant_desc(c1), constant_desc(c2), TextureDesc{}};
   scene.textures[2].kind = TEXTURE_CHECKERBOARD;
   scene.textures[2].nodes = 3;

@@ -116,14 +116,6 @@ TextureDesc texture_desc(const std::filesystem::path& file, int channels, int ma
   return t;
 }
 
-// The 2 x 2 plane of lit_plane_scene with uv = ((x + 1) / 2, (y + 1) / 2), material 0.
-Scene textured_plane(MaterialDesc m, int size) {
-  Scene s = test::lit_plane_scene(std::move(m), 20.0f, 1.0f, size, size);
-  s.triangle_uvs = {make_float2(0, 0), make_float2(1, 0), make_float2(1, 1),
-                    make_float2(0, 0), make_float2(1, 1), make_float2(0, 1)};
-  return s;
-}
-
 // The block whose constant square holds the whole footprint of pixel (x, y) (its four corners, a
 // convex quadrilateral on the plane, inside a convex square), or -1.
 int constant_block(const CameraParams& cam, int x, int y) {
@@ -355,7 +347,7 @@ TEST(TextureImages, BadImagesAreErrorsNamingTheFile) {
 
 // Kernels hold texture code only for scenes with a textured material.
 TEST(TextureFeatures, OnlyScenesWithTexturesCompileThem) {
-  Scene s = textured_plane(diffuse_material("plain", make_float3(0.5f, 0.5f, 0.5f)), 8);
+  Scene s = test::uv_plane_scene(diffuse_material("plain", make_float3(0.5f, 0.5f, 0.5f)), 8);
   EXPECT_FALSE(scene_features(s, SAMPLER_TREE).textures);
   EXPECT_NE(scene_features(s, SAMPLER_TREE).build_options().find("-DHAS_TEXTURES=0"),
             std::string::npos);
@@ -376,7 +368,7 @@ TEST(TextureRender, DiffusePlaneUnderTheSunIsExactInsideEachBlock) {
       SCOPED_TRACE(std::string(sampler) + " depth " + std::to_string(depth));
       MaterialDesc m = diffuse_material("blocks", make_float3(0, 0, 0));
       m.gpu.albedo_texture = 1;
-      Scene scene = textured_plane(m, 48);
+      Scene scene = test::uv_plane_scene(m, 48);
       scene.textures.push_back(texture_desc(file, 3, TEXTURE_MAP_VALUE));
       Light sun{};
       sun.type = LIGHT_DISTANT;
@@ -432,7 +424,7 @@ TEST(TextureRender, GlossyPlaneTakesTheTexturedAlbedoAndRoughnessEverywhere) {
         plastic_material("worn", make_float3(0, 0, 0), make_float3(1, 1, 1), 0.5f, 1.5f);
     m.gpu.albedo_texture = 1;
     m.gpu.alpha_texture = 2;
-    Scene scene = textured_plane(m, 32);
+    Scene scene = test::uv_plane_scene(m, 32);
     scene.textures.push_back(texture_desc(albedo_file, 3, TEXTURE_MAP_VALUE));
     scene.textures.push_back(texture_desc(rough_file, 1, TEXTURE_MAP_ALPHA_SQUARE));
     scene.lights.push_back(point_light(pl, I));

@@ -37,6 +37,15 @@ inline Scene lit_plane_scene(MaterialDesc m, float fov, float half, int width, i
   return s;
 }
 
+// A size x size film of lit_plane_scene (fov 20, the 2 x 2 plane) with uv = ((x + 1) / 2,
+// (y + 1) / 2).
+inline Scene uv_plane_scene(MaterialDesc m, int size) {
+  Scene s = lit_plane_scene(std::move(m), 20.0f, 1.0f, size, size);
+  s.triangle_uvs = {make_float2(0, 0), make_float2(1, 0), make_float2(1, 1),
+                    make_float2(0, 0), make_float2(1, 1), make_float2(0, 1)};
+  return s;
+}
+
 // The unit direction of the camera ray through raster point (fx, fy) and where it meets the plane
 // z = 0 (*X).
 inline float3 camera_ray_to_plane(const CameraParams& cam, float fx, float fy, float3* X) {

@@ -74,4 +74,13 @@ inline Material make_coated_conductor(float ior, float alpha, float3 eta, float3
   return m;
 }
 
+// pbrt-v4's diffuse transmission: reflectance r, transmittance t.
+inline Material make_diffuse_transmission(float3 r, float3 t) {
+  Material m{};
+  m.type = MATERIAL_DIFFUSE_TRANSMISSION;
+  m.albedo = f4_from3(r, 0.0f);
+  m.specular = f4_from3(t, 0.0f);
+  return m;
+}
+
 } // namespace canopy::test
