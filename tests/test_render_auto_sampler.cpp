@@ -149,9 +149,9 @@ TEST(AutoSampler, ExplorationWeightsAreInverseVarianceToTheChoiceAndDropAMissedT
 }
 
 // The most efficient is chosen. A leader whose lead over another is not significant tile by tile
-// (its variance is mostly one tile's) gives way to that one's lighter tail; a leader that is
-// better in every tile stays, whatever its tail.
-TEST(AutoSampler, TheChoiceIsTheMostEfficientUnlessALighterTailIsNotSignificantlyWorse) {
+// (its variance is mostly one tile's) gives way to that one's lighter tail, or to a cheaper one
+// whose tail is no heavier; a leader that is better in every tile stays, whatever its tail.
+TEST(AutoSampler, TheChoiceIsTheMostEfficientUnlessALighterTailOrACheaperIsNotSignificantlyWorse) {
   auto candidate = [](const char* label, std::vector<double> tiles, double tail, double t) {
     PilotResult p;
     p.label = label;
@@ -183,6 +183,20 @@ TEST(AutoSampler, TheChoiceIsTheMostEfficientUnlessALighterTailIsNotSignificantl
   // The same lead, significant: b stays, whatever its tail.
   c[1] = candidate("b", even, 0.6, 0.5);
   EXPECT_EQ(choose_candidate(c, &reason), 1u);
+  // A cheaper candidate whose loss to the leader is not significant (mostly one tile's) and whose
+  // tail is no heavier is taken; with a heavier tail it is not.
+  std::vector<double> noisy = one_tile;
+  for (double& v : noisy)
+    v *= 3.0;
+  c = {candidate("x", even, 0.01, 1.0), candidate("y", noisy, 0.01, 0.5)};
+  EXPECT_EQ(choose_candidate(c, &reason), 1u);
+  EXPECT_GT(c[0].efficiency, c[1].efficiency);
+  EXPECT_NE(reason.find("cheaper"), std::string::npos);
+  c[1].stats.tail_share = 0.02;
+  EXPECT_EQ(choose_candidate(c, &reason), 0u);
+  // Significantly less efficient: not taken, however cheap.
+  c[1] = candidate("y", std::vector<double>(64, 3.0 / 64.0), 0.01, 0.5);
+  EXPECT_EQ(choose_candidate(c, &reason), 0u);
 }
 
 // Power sampling is hopeless here: the exploration must see it, its samples must weigh little,
@@ -227,8 +241,8 @@ TEST(AutoSampler, TheExplorationRanksByEfficiencyAndItsSamplesArePartOfTheImage)
 // unbiased: over 8 seeds its image mean equals the exhaustive estimator's within 5 standard errors
 // of the difference; under point lights alone, and with sphere lights in view (whose pixels weigh
 // every sample 1), with the exploration on every row, on bands of them (one in three) for the
-// splitting candidate, and (at 5 spp, too few for two samples of each candidate per pixel) on
-// interleaved rows, a third of them each.
+// splitting candidate, and (at 5 spp, below kFilmExplorationMinSpp) on interleaved rows, a third
+// of them each.
 class CombinedImage : public ::testing::TestWithParam<std::tuple<bool, int>> {};
 
 TEST_P(CombinedImage, IsUnbiased) {
@@ -274,7 +288,7 @@ TEST_P(CombinedImage, IsUnbiased) {
   Renderer renderer(rt, scene, base);
   std::vector<double> means;
   for (uint32_t seed = 1; seed <= 8; ++seed) {
-    rs.spp = interleaved ? 5 : 24;
+    rs.spp = interleaved ? 5 : kFilmExplorationMinSpp;
     rs.seed = seed;
     AutoRender r = render_auto(renderer, base, rs, period);
     ASSERT_FALSE(r.choice.candidates.empty());
@@ -377,7 +391,7 @@ TEST(AutoSampler, ACandidateOnBandsIsComparedOverItsRows) {
   Renderer renderer(rt, scene, base);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
     RenderSettings rs;
-    rs.spp = 24;
+    rs.spp = kFilmExplorationMinSpp;
     rs.seed = seed;
     AutoRender r = render_auto(renderer, base, rs, 4);
     ASSERT_EQ(r.choice.candidates.size(), 3u);

@@ -214,7 +214,22 @@ size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
   }
   if (lighter != c.size()) {
     *reason = fmt::format("not significantly less efficient than {}, lighter tail", c[best].label);
-    return lighter;
+    best = lighter;
+  }
+  // A cheaper candidate (less time per pass) that is not significantly less efficient, with a
+  // tail no heavier: the cheapest such. Its samples come faster (a render of a given spp ends
+  // sooner), and more samples average its rare large ones better than the exploration could see.
+  size_t cheaper = c.size();
+  for (size_t i = 0; i < c.size(); ++i) {
+    if (!ranked(i) || !(c[i].pass_seconds < c[best].pass_seconds) ||
+        c[i].stats.tail_share > c[best].stats.tail_share ||
+        significantly_less(c[best].stats, c[best].pass_seconds, c[i].stats, c[i].pass_seconds))
+      continue;
+    if (cheaper == c.size() || c[i].pass_seconds < c[cheaper].pass_seconds) cheaper = i;
+  }
+  if (cheaper != c.size()) {
+    *reason = fmt::format("not significantly less efficient than {}, cheaper", c[best].label);
+    best = cheaper;
   }
   return best;
 }
@@ -284,11 +299,12 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     wave_passes.push_back(int(std::clamp(std::ceil(wave / npix), 1.0, 256.0)));
   }
   int renders = 0;
-  std::vector<int> passes = settings.window.empty()
+  std::vector<int> passes = settings.window.empty() && settings.spp >= kFilmExplorationMinSpp
                                 ? plan_exploration(settings.spp, wave_passes, &renders)
                                 : std::vector<int>();
-  // Too few samples for every candidate to render two in each pixel: each renders two on its
-  // own interleaved rows (every n-th row), the chosen one the rest of every pixel.
+  // Too few samples for every candidate to explore the film at a small share of the render's
+  // cost: each renders two on its own interleaved rows (every n-th row), the chosen one the rest
+  // of every pixel.
   const int n = int(cand.size());
   const bool interleaved =
       passes.empty() && settings.window.empty() && settings.spp >= kInterleavedMinSpp && fh >= n;
@@ -329,7 +345,10 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     c.first_sample = next;
     rs.first_sample = next;
     rs.spp = 1;
+    const auto first = Clock::now();
     Film film = renderer.render(rs);
+    // On interleaved rows the untimed pass is the timed passes' size too: the faster counts.
+    const double first_pass = std::chrono::duration<double>(Clock::now() - first).count();
     next += 1;
     rs.spp = passes[i];
     for (int r = 0; r < renders; ++r) {
@@ -343,6 +362,7 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       add_samples(film, f);
       next += passes[i];
     }
+    if (interleaved) c.pass_seconds = std::min(c.pass_seconds, first_pass / c.explored_share);
     c.samples = next - c.first_sample;
     films.push_back(std::move(film));
   }

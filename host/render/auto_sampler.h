@@ -94,7 +94,9 @@ std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, 
 // Marks the candidates that missed their tail (mean more than 4 standard errors below the median
 // candidate's), then returns the chosen one's index: the most efficient of the rest, unless a
 // candidate that it does not beat significantly has at most half its tail share (the lighter tail
-// is taken: a heavy tail's variance from a few samples is unreliable). "Significantly": the
+// is taken: a heavy tail's variance from a few samples is unreliable); then, the cheapest
+// candidate (less time per pass) that the choice does not beat significantly and whose tail is no
+// heavier: its render of the user's spp ends sooner at no significant loss. "Significantly": the
 // difference of variance x seconds per pass, summed over tiles, exceeds 1.96 standard errors of
 // that sum estimated from the tiles' differences (a paired comparison: the spread between tiles
 // that every candidate shares cancels). Without a measured variance (a black image), the fastest.
@@ -118,9 +120,12 @@ std::vector<double> exploration_weights(std::vector<PilotResult> other);
 // that does not weighs the per-wave costs more than the render does). `period` <= 0: the most of
 // 1 to 4 that keeps that many pixels and a band in every tile of the film's 8 x 8.
 constexpr int kExploreBandRows = 8;
-// Below the room for two samples per candidate in every pixel (plan_exploration), down to this
-// many samples per pixel, each candidate renders two samples on its own interleaved rows (every
-// third row: the rows of all candidates show the same image) and the chosen one the rest.
+// From kFilmExplorationMinSpp samples per pixel the candidates explore the film (or its bands,
+// plan_exploration). Below, down to kInterleavedMinSpp, each candidate renders two samples on its
+// own interleaved rows (every third row: the rows of all candidates show the same image) and the
+// chosen one the rest: the exploration then costs about 2 spp of the render, where on the film it
+// costs at least 6 spp of each candidate (more than half of a 1 s preview's samples).
+constexpr int kFilmExplorationMinSpp = 32;
 constexpr int kInterleavedMinSpp = 3;
 constexpr int kExploredPixels = 16384;
 RowBands exploration_bands(int width, int height, int period = 0);
@@ -129,8 +134,8 @@ RowBands exploration_bands(int width, int height, int period = 0);
 // candidate after exploring all, some on bands of rows (exploration_bands(film, explore_period);
 // see the file comment); the film's sums are weighted so that its mean is the
 // unbiased image and its count per pixel is spp. Leaves `renderer` set to the chosen candidate.
-// With too few samples to explore on every pixel (plan_exploration), down to kInterleavedMinSpp,
-// the candidates explore on interleaved rows; below that kFewSamplesCandidate renders it all, and
+// Below kFilmExplorationMinSpp spp, down to kInterleavedMinSpp, the candidates explore on
+// interleaved rows; below that kFewSamplesCandidate renders it all, and
 // in a window the last candidate.
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
                        const RenderSettings& settings, int explore_period = 0);

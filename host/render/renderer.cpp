@@ -216,7 +216,16 @@ void Renderer::compile_kernels() {
   // vacuum: every path passes unchanged, so forcing the feature on changes no image).
   volume_stages_ = features.medium;
   stats_.kernel_options = features.build_options();
-  program_ = rt_.build_program(kKernelFiles, stats_.kernel_options, &stats_.program_from_cache);
+  // A sampler switched back to (render_auto) finds its program built: PoCL then also keeps its
+  // kernels' work-group functions loaded.
+  auto built = programs_.find(stats_.kernel_options);
+  if (built == programs_.end()) {
+    BuiltProgram p;
+    p.program = rt_.build_program(kKernelFiles, stats_.kernel_options, &p.from_cache);
+    built = programs_.emplace(stats_.kernel_options, std::move(p)).first;
+  }
+  program_ = built->second.program;
+  stats_.program_from_cache = built->second.from_cache;
   stats_.compile_seconds = seconds_since(t0);
 }
 
@@ -274,7 +283,8 @@ void Renderer::set_light_sampler(const RendererOptions& options) {
   // The geometry, textures and the rest stay; only the sampler's data and the kernels change.
   path_sampler_id(options.path_sampler); // a known name
   options_ = options;
-  release_buffers(); // sized for the previous sampler
+  // The scratch buffers stay: scratch_buffer() grows one that is too small, and a kept buffer
+  // spares the next render its first-touch page faults.
   LightTree previous = std::move(sampler_.tree);
   sampler_ =
       make_light_sampler_data(scene_.lights, options.light_sampler, options.split_threshold,

@@ -171,7 +171,8 @@ public:
   const Scene& scene() const { return scene_; }
   // Switches to another light sampler (options.light_sampler and its settings; all_features and
   // split_queue_items as before): rebuilds its data and the kernels, keeps the geometry, textures
-  // and environment maps (render/auto_sampler.h tries several this way).
+  // and environment maps (render/auto_sampler.h tries several this way), the device buffers that
+  // render() keeps and every program built so far (a switch back to a sampler reuses its own).
   void set_light_sampler(const RendererOptions& options);
   // Zeroes what render() accumulates (time, counts, stage timings, histogram), keeping the build,
   // upload and compile figures: the auto sampler's pilot renders are not the render's.
@@ -180,8 +181,7 @@ public:
   // `wave_size`, before the render's own size bounds it: fewer for a splitting sampler, whose wave
   // must fit its cuts in the split queue (RendererOptions::split_queue_items).
   size_t paths_per_wave(size_t wave_size) const;
-  // Frees the device buffers that render() keeps for the next render (set_light_sampler does
-  // too).
+  // Frees the device buffers that render() keeps for the next render.
   void release_buffers() { buffers_.clear(); }
 
 private:
@@ -206,6 +206,11 @@ private:
   LightSamplerData sampler_;
   RenderStats stats_;
   cl::Program program_;
+  struct BuiltProgram {
+    cl::Program program;
+    bool from_cache = false; // RenderStats::program_from_cache
+  };
+  std::unordered_map<std::string, BuiltProgram> programs_; // by kernel options: compile_kernels()
   bool brdf_stages_ = false;   // brdf-mis / brdf-oriented on a scene with a glossy material
   bool volume_stages_ = false; // kernels with a medium: shade_volume and segment light picks
   DeviceScene device_;
