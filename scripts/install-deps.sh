@@ -8,7 +8,7 @@ packages=(
   build-essential cmake pkg-config clang-format python3
   pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
   libembree-dev
-  libopenimageio-dev openimageio-tools
+  libopenimageio-dev openimageio-tools libopenexr-dev libpng-dev
   libtinyobjloader-dev libassimp-dev zlib1g-dev nlohmann-json3-dev libcli11-dev libfmt-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   slurm-wlm munge

@@ -29,6 +29,8 @@ std::string read_text(const std::filesystem::path& p) {
   return ss.str();
 }
 
+} // namespace
+
 std::filesystem::path executable_dir() {
   char buf[4096];
   ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
@@ -36,8 +38,6 @@ std::filesystem::path executable_dir() {
   buf[n] = 0;
   return std::filesystem::path(buf).parent_path();
 }
-
-} // namespace
 
 const char* cl_error_name(cl_int code) {
   switch (code) {

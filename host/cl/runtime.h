@@ -41,6 +41,9 @@ std::vector<DeviceInfo> list_devices();
 // share/canopy/cl next to the binary's prefix, else the source tree's cl/.
 std::filesystem::path kernel_dir();
 
+// The directory of the running executable (/proc/self/exe); empty if unknown.
+std::filesystem::path executable_dir();
+
 class ClRuntime {
 public:
   // `device_name` empty: the first PoCL CPU device (else the first CPU device, else any).

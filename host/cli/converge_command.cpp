@@ -1,10 +1,10 @@
 #include "cli/converge_command.h"
 
 #include "cl/runtime.h"
-#include "cli/plot.h"
 #include "image/error_stats.h"
 #include "image/image_compare.h"
 #include "image/image_io.h"
+#include "oiio/plot.h"
 #include "render/auto_sampler.h"
 #include "render/renderer.h"
 #include "scene/scene.h"

@@ -1,6 +1,5 @@
 #include "image/image_compare.h"
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -54,16 +53,15 @@ RgbImage clamp_image(const RgbImage& img, float max) {
 
 std::map<std::string, std::string> read_image_attributes(const std::filesystem::path& file,
                                                          const std::string& prefix) {
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in)
-    throw std::runtime_error(
-        fmt::format("{}: cannot read image ({})", file.string(), OIIO::geterror()));
-  std::map<std::string, std::string> out;
-  for (const OIIO::ParamValue& p : in->spec().extra_attribs) {
-    std::string name = p.name().string();
-    if (name.compare(0, prefix.size(), prefix) != 0) continue;
-    out[name] = p.get_string();
+  DecodedImage img;
+  try {
+    img = read_image_file(file);
+  } catch (const ImageFileError& e) {
+    throw std::runtime_error(fmt::format("{}: cannot read image ({})", file.string(), e.what()));
   }
+  std::map<std::string, std::string> out;
+  for (const auto& [name, value] : img.attributes)
+    if (name.compare(0, prefix.size(), prefix) == 0) out[name] = value;
   return out;
 }
 

@@ -1,6 +1,5 @@
 #include "image/image_io.h"
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -9,6 +8,7 @@
 #include <csignal>
 #include <cstring>
 #include <fcntl.h>
+#include <functional>
 #include <stdexcept>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -75,8 +75,8 @@ private:
 // Writes through a temporary file in the destination directory, then rename(2)s it over `file`:
 // a reader (or a second render to the same path) sees the previous image or the new one, never a
 // partial file, and an interrupted write leaves the previous file intact.
-void write_pixels(const std::filesystem::path& file, const OIIO::ImageSpec& spec,
-                  OIIO::TypeDesc type, const void* data) {
+void write_through_temporary(const std::filesystem::path& file,
+                             const std::function<void(const std::filesystem::path&)>& write) {
   std::filesystem::path parent = file.parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
   std::string tmpl = (parent.empty() ? std::filesystem::path(".") : parent).string() + "/." +
@@ -89,17 +89,13 @@ void write_pixels(const std::filesystem::path& file, const OIIO::ImageSpec& spec
                                          std::strerror(errno)));
   const std::string tmp(name.data());
   TempFileGuard guard(tmp);
-  // The plugin is chosen by the extension, which the temporary shares with the destination.
-  auto out = OIIO::ImageOutput::create(tmp);
-  if (!out) {
-    ::close(fd);
-    throw std::runtime_error(fmt::format("{}: cannot write ({})", file.string(), OIIO::geterror()));
-  }
   ::fchmod(fd,
            0644 & ~current_umask()); // mkstemp creates 0600; an image is as readable as any file
-  if (!out->open(tmp, spec) || !out->write_image(type, data) || !out->close()) {
+  try {
+    write(tmp);
+  } catch (const ImageFileError& e) {
     ::close(fd);
-    throw std::runtime_error(fmt::format("{}: cannot write ({})", file.string(), out->geterror()));
+    throw std::runtime_error(fmt::format("{}: cannot write ({})", file.string(), e.what()));
   }
   // The data reaches the disk before the name points at it.
   ::fsync(fd);
@@ -115,48 +111,37 @@ void write_pixels(const std::filesystem::path& file, const OIIO::ImageSpec& spec
 void write_exr(const std::filesystem::path& file, const RgbImage& img,
                const std::vector<std::pair<std::string, std::string>>& metadata,
                const std::optional<ImageWindow>& window) {
-  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
-  if (window) {
-    spec.x = window->x;
-    spec.y = window->y;
-    spec.full_x = spec.full_y = 0;
-    spec.full_width = window->full_width;
-    spec.full_height = window->full_height;
-  }
-  spec.attribute("compression", "zip");
-  for (const auto& [k, v] : metadata)
-    spec.attribute(k, v);
-  write_pixels(file, spec, OIIO::TypeDesc::FLOAT, img.rgb.data());
+  const ImageWindow w = window ? *window : ImageWindow{0, 0, img.width, img.height};
+  write_through_temporary(file, [&](const std::filesystem::path& tmp) {
+    write_exr_file(tmp, img.width, img.height, img.rgb.data(), metadata, w);
+  });
 }
 
 void write_png(const std::filesystem::path& file, const RgbImage& img) {
   std::vector<unsigned char> px(img.rgb.size());
   for (size_t i = 0; i < px.size(); ++i)
     px[i] = (unsigned char)std::lround(255.0f * srgb_encode(img.rgb[i]));
-  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:ColorSpace", "sRGB");
-  write_pixels(file, spec, OIIO::TypeDesc::UINT8, px.data());
+  write_through_temporary(file, [&](const std::filesystem::path& tmp) {
+    write_png_file(tmp, img.width, img.height, px.data());
+  });
 }
 
 RgbImage read_image(const std::filesystem::path& file) {
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in)
-    throw std::runtime_error(
-        fmt::format("{}: cannot read image ({})", file.string(), OIIO::geterror()));
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.nchannels < 3)
+  DecodedImage d;
+  try {
+    d = read_image_file(file);
+  } catch (const ImageFileError& e) {
+    throw std::runtime_error(fmt::format("{}: cannot read image ({})", file.string(), e.what()));
+  }
+  if (d.channels < 3)
     throw std::runtime_error(fmt::format("{}: need at least 3 channels", file.string()));
   RgbImage img;
-  img.width = spec.width;
-  img.height = spec.height;
-  std::vector<float> all(size_t(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-    throw std::runtime_error(
-        fmt::format("{}: cannot read image ({})", file.string(), in->geterror()));
-  img.rgb.resize(size_t(spec.width) * spec.height * 3);
-  for (size_t p = 0; p < size_t(spec.width) * spec.height; ++p)
+  img.width = d.width;
+  img.height = d.height;
+  img.rgb.resize(size_t(d.width) * d.height * 3);
+  for (size_t p = 0; p < size_t(d.width) * d.height; ++p)
     for (int c = 0; c < 3; ++c)
-      img.rgb[3 * p + c] = all[p * spec.nchannels + c];
+      img.rgb[3 * p + c] = d.pixels[p * d.channels + c];
   return img;
 }
 

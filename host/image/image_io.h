@@ -1,5 +1,8 @@
-// Image output through OpenImageIO: linear float EXR (with metadata) and sRGB 8-bit PNG.
+// Images in and out: linear float EXR (with metadata) and sRGB 8-bit PNG, written whole or not at
+// all; any image read as linear RGB (image_file.h).
 #pragma once
+
+#include "image/image_file.h"
 
 #include <filesystem>
 #include <optional>
@@ -14,12 +17,6 @@ struct RgbImage {
   std::vector<float> rgb; // row-major, top row first, 3 floats per pixel, linear
 };
 
-// Where an image's pixels sit in a larger one: EXR's data window (origin x, y) inside its display
-// window (full_width x full_height from 0, 0).
-struct ImageWindow {
-  int x = 0, y = 0, full_width = 0, full_height = 0;
-};
-
 // Writes a linear float EXR; `metadata` entries become string attributes (e.g.
 // "canopy:sampler"); `window`, if given, places the pixels in a larger display window. Throws
 // std::runtime_error naming the file on failure.
@@ -30,7 +27,8 @@ void write_exr(const std::filesystem::path& file, const RgbImage& img,
 // Writes an 8-bit PNG with the sRGB transfer curve (values clamped to [0, 1]).
 void write_png(const std::filesystem::path& file, const RgbImage& img);
 
-// Reads any image OpenImageIO understands into linear RGB float (first three channels).
+// Reads an image (image_file.h: EXR, PNG or what OpenImageIO reads) into RGB float: its first
+// three channels as stored.
 RgbImage read_image(const std::filesystem::path& file);
 
 float srgb_encode(float linear);

@@ -2,7 +2,6 @@
 
 #include "scene/scene.h" // printable
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -96,11 +95,16 @@ PartialImage read_partial_exr(const std::filesystem::path& file) {
   };
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw fail("no such file");
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in) throw fail(fmt::format("cannot read ({})", printable(OIIO::geterror(), 300)));
-  const OIIO::ImageSpec& spec = in->spec();
+  DecodedImage img;
+  try {
+    img = read_image_file(file);
+  } catch (const ImageFileError& e) {
+    throw fail(fmt::format("cannot read ({})", printable(e.what(), 300)));
+  }
   auto attr = [&](const char* key) {
-    std::string v = spec.get_string_attribute(key);
+    std::string v;
+    for (const auto& [k, value] : img.attributes)
+      if (k == key) v = value;
     if (v.empty())
       throw fail(fmt::format("not a Canopy render (no {} attribute; a merge of unequal sample "
                              "coverage cannot be merged again)",
@@ -130,27 +134,23 @@ PartialImage read_partial_exr(const std::filesystem::path& file) {
   if (!parse_ints(samples, ':', 2, 0, kSide, v) || v[0] >= v[1])
     throw fail(fmt::format("bad {} '{}' (want A:B, A < B)", kSamples, printable(samples, 100)));
   info.sample_begin = int(v[0]), info.sample_end = int(v[1]);
-  if (spec.x != info.x0 || spec.y != info.y0 || spec.width != info.x1 - info.x0 ||
-      spec.height != info.y1 - info.y0 || spec.nchannels < 3)
+  if (img.window.x != info.x0 || img.window.y != info.y0 || img.width != info.x1 - info.x0 ||
+      img.height != info.y1 - info.y0 || img.channels < 3)
     throw fail(fmt::format("its pixels ({}x{} at {}, {}, {} channels) are not the window {} of "
                            "{}",
-                           spec.width, spec.height, spec.x, spec.y, spec.nchannels,
+                           img.width, img.height, img.window.x, img.window.y, img.channels,
                            window_text(info.x0, info.y0, info.x1, info.y1), kCrop));
-  const size_t n = size_t(spec.width) * size_t(spec.height);
-  std::vector<float> all(n * size_t(spec.nchannels));
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-    throw fail(
-        fmt::format("cannot read its pixels, truncated? ({})", printable(in->geterror(), 300)));
-  p.pixels.width = spec.width;
-  p.pixels.height = spec.height;
+  const size_t n = size_t(img.width) * size_t(img.height);
+  const std::vector<float>& all = img.pixels;
+  p.pixels.width = img.width;
+  p.pixels.height = img.height;
   p.pixels.rgb.resize(3 * n);
   for (size_t i = 0; i < n; ++i)
     for (size_t c = 0; c < 3; ++c) {
-      float x = all[i * size_t(spec.nchannels) + c];
+      float x = all[i * size_t(img.channels) + c];
       if (!std::isfinite(x))
-        throw fail(fmt::format("pixel ({}, {}) is not finite",
-                               info.x0 + int(i % size_t(spec.width)),
-                               info.y0 + int(i / size_t(spec.width))));
+        throw fail(fmt::format("pixel ({}, {}) is not finite", info.x0 + int(i % size_t(img.width)),
+                               info.y0 + int(i / size_t(img.width))));
       p.pixels.rgb[3 * i + c] = x;
     }
   return p;

@@ -3,7 +3,6 @@
 #include "image/image_io.h"
 #include "image/stderr_capture.h"
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include <cmath>
@@ -13,47 +12,27 @@
 
 namespace canopy {
 
-namespace {
-
-// Why an image could not be read, for the end of Canopy's one-line message: what the image
-// library printed (captured, stderr_capture.h), else the first line of OpenImageIO's error;
-// empty if neither says anything.
-std::string read_failure(const std::string& printed, const std::string& oiio_error) {
-  if (!printed.empty()) return printed;
-  return oiio_error.substr(0, oiio_error.find('\n'));
-}
-
-} // namespace
-
 RenderImage read_render_image(const std::filesystem::path& file, const std::string& what,
                               size_t max_texels, int channels, ImageEncoding encoding, float gamma,
                               const std::string& where) {
   const std::string name = file.string();
   const std::string who = where.empty() ? name : fmt::format("{}: {}", where, name);
-  StderrCapture library_output; // a corrupt PNG makes libpng print its own line
-  auto in = OIIO::ImageInput::open(name);
-  if (!in) {
-    std::string why = read_failure(library_output.finish(), OIIO::geterror());
-    throw SceneError(fmt::format("{}: cannot read the {}{}", who, what,
-                                 why.empty() ? "" : fmt::format(" ({})", why)));
-  }
-  const OIIO::ImageSpec spec = in->spec();
-  const int nc = spec.nchannels;
-  if (spec.width < 1 || spec.height < 1 || nc < 1)
-    throw SceneError(fmt::format("{}: a {} needs pixels", who, what));
-  if (uint64_t(spec.width) * uint64_t(spec.height) > max_texels)
-    throw SceneError(fmt::format("{}: {}x{} texels is more than a {} may have ({})", who,
-                                 spec.width, spec.height, what, max_texels));
-  std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(nc));
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data())) {
-    std::string why = read_failure(library_output.finish(), in->geterror());
-    throw SceneError(fmt::format("{}: cannot read the {} (truncated or corrupt{})", who, what,
-                                 why.empty() ? "" : ": " + why));
+  StderrCapture library_output; // what an image library prints on a bad file joins the message
+  DecodedImage img;
+  try {
+    img = read_image_file(file, max_texels);
+  } catch (const ImageTooLarge& e) {
+    library_output.finish();
+    throw SceneError(fmt::format("{}: {}x{} texels is more than a {} may have ({})", who, e.width,
+                                 e.height, what, max_texels));
+  } catch (const ImageFileError& e) {
+    const std::string printed = library_output.finish();
+    throw SceneError(fmt::format("{}: cannot read the {} ({})", who, what,
+                                 printed.empty() ? std::string(e.what()) : printed));
   }
   library_output.finish();
-  const bool integer = spec.format.basetype != OIIO::TypeDesc::FLOAT &&
-                       spec.format.basetype != OIIO::TypeDesc::HALF &&
-                       spec.format.basetype != OIIO::TypeDesc::DOUBLE;
+  const int nc = img.channels;
+  const bool integer = !img.floating;
   const bool srgb = encoding == ImageEncoding::Srgb || (encoding == ImageEncoding::Auto && integer);
   auto decode = [&](float v) {
     if (srgb) return srgb_decode(v);
@@ -61,19 +40,19 @@ RenderImage read_render_image(const std::filesystem::path& file, const std::stri
     return v;
   };
   RenderImage out;
-  out.width = spec.width;
-  out.height = spec.height;
+  out.width = img.width;
+  out.height = img.height;
   out.channels = channels;
-  const size_t n = size_t(spec.width) * size_t(spec.height);
+  const size_t n = size_t(img.width) * size_t(img.height);
   out.values.resize(n * size_t(channels));
   const int colour = std::min(nc, 3) == 2 ? 1 : std::min(nc, 3); // grey + alpha: grey
   for (size_t p = 0; p < n; ++p) {
     float c[3];
     for (int k = 0; k < 3; ++k) {
-      float v = all[p * size_t(nc) + size_t(colour == 3 ? k : 0)];
+      float v = img.pixels[p * size_t(nc) + size_t(colour == 3 ? k : 0)];
       if (!std::isfinite(v) || v < 0.0f)
         throw SceneError(fmt::format("{}: texel ({}, {}) is {} (a {} must be finite and >= 0)", who,
-                                     p % size_t(spec.width), p / size_t(spec.width), v, what));
+                                     p % size_t(img.width), p / size_t(img.width), v, what));
       c[k] = decode(v);
     }
     if (channels == 1)

@@ -1,7 +1,8 @@
 // A small log-log line plot written as PNG through OpenImageIO (ImageBufAlgo::render_line /
-// render_box / render_text). Text needs a TrueType font: OpenImageIO searches the system font
-// directories for `font` (Debian: fonts-dejavu-core, pulled in by OpenImageIO); without one the
-// plot is still drawn, only without labels, and `write_plot_png` returns false.
+// render_box / render_text), drawn in the OpenImageIO module (oiio/module.h). Text needs a
+// TrueType font: OpenImageIO searches the system font directories for `font` (Debian:
+// fonts-dejavu-core, pulled in by OpenImageIO); without one the plot is still drawn, only without
+// labels, and `write_plot_png` returns false.
 #pragma once
 
 #include <filesystem>
@@ -21,10 +22,13 @@ struct PlotOptions {
   std::string font = "DejaVuSans";
 };
 
-// Writes the plot. Returns true when the text was drawn too. Throws std::runtime_error naming the
-// file when it cannot be written.
+// Writes the plot (through the module). Returns true when the text was drawn too. Throws
+// std::runtime_error naming the file when it cannot be written.
 bool write_plot_png(const std::filesystem::path& file, const std::vector<PlotSeries>& series,
                     const PlotOptions& options);
+// The drawing itself, in the module: as write_plot_png.
+bool draw_plot_png(const std::filesystem::path& file, const std::vector<PlotSeries>& series,
+                   const PlotOptions& options);
 
 // Tick values for a log axis over [lo, hi]: decades, plus 2 and 5 when the range is short.
 std::vector<double> log_ticks(double lo, double hi);

@@ -1,4 +1,4 @@
-#include "cli/plot.h"
+#include "oiio/plot.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -135,8 +135,8 @@ std::string tick_label(double v) {
   return fmt::format("{:.0f}e{}", m, int(e));
 }
 
-bool write_plot_png(const std::filesystem::path& file, const std::vector<PlotSeries>& series,
-                    const PlotOptions& o) {
+bool draw_plot_png(const std::filesystem::path& file, const std::vector<PlotSeries>& series,
+                   const PlotOptions& o) {
   const int W = o.width, H = o.height;
   const double left = 92, right = 24, top = o.title.empty() ? 20 : 48, bottom = 66;
   const double x0 = left, x1 = W - right, y0 = H - bottom, y1 = top; // plot box (y up)
