@@ -183,8 +183,8 @@ TEST(AutoSampler, TheChoiceIsTheMostEfficientUnlessALighterTailOrACheaperIsNotSi
   // The same lead, significant: b stays, whatever its tail.
   c[1] = candidate("b", even, 0.6, 0.5);
   EXPECT_EQ(choose_candidate(c, &reason), 1u);
-  // A cheaper candidate whose loss to the leader is not significant (mostly one tile's) and whose
-  // tail is no heavier is taken; with a heavier tail it is not.
+  // A candidate of half the cost whose loss to the leader is not significant (mostly one tile's)
+  // and whose tail is no heavier is taken; with a heavier tail it is not.
   std::vector<double> noisy = one_tile;
   for (double& v : noisy)
     v *= 3.0;
@@ -193,6 +193,10 @@ TEST(AutoSampler, TheChoiceIsTheMostEfficientUnlessALighterTailOrACheaperIsNotSi
   EXPECT_GT(c[0].efficiency, c[1].efficiency);
   EXPECT_NE(reason.find("cheaper"), std::string::npos);
   c[1].stats.tail_share = 0.02;
+  EXPECT_EQ(choose_candidate(c, &reason), 0u);
+  // Less cheap than kCheaperFactor of the choice's time: the more efficient stays.
+  c[1].stats.tail_share = 0.01;
+  c[1].pass_seconds = 0.8;
   EXPECT_EQ(choose_candidate(c, &reason), 0u);
   // Significantly less efficient: not taken, however cheap.
   c[1] = candidate("y", std::vector<double>(64, 3.0 / 64.0), 0.01, 0.5);

@@ -216,12 +216,12 @@ size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
     *reason = fmt::format("not significantly less efficient than {}, lighter tail", c[best].label);
     best = lighter;
   }
-  // A cheaper candidate (less time per pass) that is not significantly less efficient, with a
-  // tail no heavier: the cheapest such. Its samples come faster (a render of a given spp ends
-  // sooner), and more samples average its rare large ones better than the exploration could see.
+  // A candidate at most half as costly per pass that is not significantly less efficient, with a
+  // tail no heavier: the cheapest such. A render of the user's spp then ends at least twice as
+  // soon for no significant loss; between candidates of similar cost the more efficient stays.
   size_t cheaper = c.size();
   for (size_t i = 0; i < c.size(); ++i) {
-    if (!ranked(i) || !(c[i].pass_seconds < c[best].pass_seconds) ||
+    if (!ranked(i) || !(c[i].pass_seconds <= kCheaperFactor * c[best].pass_seconds) ||
         c[i].stats.tail_share > c[best].stats.tail_share ||
         significantly_less(c[best].stats, c[best].pass_seconds, c[i].stats, c[i].pass_seconds))
       continue;

@@ -95,13 +95,15 @@ std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, 
 // candidate's), then returns the chosen one's index: the most efficient of the rest, unless a
 // candidate that it does not beat significantly has at most half its tail share (the lighter tail
 // is taken: a heavy tail's variance from a few samples is unreliable); then, the cheapest
-// candidate (less time per pass) that the choice does not beat significantly and whose tail is no
-// heavier: its render of the user's spp ends sooner at no significant loss. "Significantly": the
+// candidate of at most kCheaperFactor times its time per pass that it does not beat significantly
+// and whose tail is no heavier: its render of the user's spp ends much sooner at no significant
+// loss. "Significantly": the
 // difference of variance x seconds per pass, summed over tiles, exceeds 1.96 standard errors of
 // that sum estimated from the tiles' differences (a paired comparison: the spread between tiles
 // that every candidate shares cancels). Without a measured variance (a black image), the fastest.
 // Sets `reason`.
 size_t choose_candidate(std::vector<PilotResult>& candidates, std::string* reason);
+constexpr double kCheaperFactor = 0.5;
 
 // The weights of the candidates' samples in one half of the film, from `other`: the candidates
 // with their measurements over the other half (and their seconds per pass). The choice those
