@@ -5,8 +5,10 @@
 #include "image/image_file.h"
 #include "image/image_io.h"
 
+#include "support/test_temp_dir.h"
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,11 +21,7 @@ using namespace canopy;
 namespace {
 
 std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() /
-           ("canopy_img_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-  std::filesystem::create_directories(d);
-  return d;
+  return test::test_temp_dir("img");
 }
 
 // Random values in [0, 1] (a few exactly 0 and 1), `n` of them.
@@ -34,6 +32,14 @@ std::vector<float> random_values(size_t n, uint32_t seed) {
   for (size_t i = 0; i < n; ++i)
     v[i] = i % 17 == 0 ? float(i % 2) : u(rng);
   return v;
+}
+
+RgbImage random_image(int w, int h, uint32_t seed) {
+  RgbImage img;
+  img.width = w;
+  img.height = h;
+  img.rgb = random_values(size_t(w) * size_t(h) * 3, seed);
+  return img;
 }
 
 void write_with_oiio(const std::filesystem::path& file, const OIIO::ImageSpec& spec,
@@ -106,10 +112,7 @@ TEST(ImageFiles, ExrOfHalfAndFloatChannelsReadsAsOpenImageIOReadsIt) {
 // Canopy's reader and by OpenImageIO, the same window and attributes.
 TEST(ImageFiles, ExrWindowAndAttributesRoundTrip) {
   const auto file = temp_dir() / "crop.exr";
-  RgbImage img;
-  img.width = 6;
-  img.height = 4;
-  img.rgb = random_values(6 * 4 * 3, 3);
+  RgbImage img = random_image(6, 4, 3);
   img.rgb[5] = 1e-40f; // a denormal survives
   write_exr(file, img, {{"canopy:samples", "0:16"}, {"canopy:scene", "a b.json"}},
             ImageWindow{10, 20, 64, 48});
@@ -141,10 +144,7 @@ TEST(ImageFiles, ExrWindowAndAttributesRoundTrip) {
 // The PNG writer stores the sRGB encoding of each value to the nearest 8-bit code.
 TEST(ImageFiles, PngWritesTheNearestSrgbCode) {
   const auto file = temp_dir() / "out.png";
-  RgbImage img;
-  img.width = 5;
-  img.height = 3;
-  img.rgb = random_values(5 * 3 * 3, 4);
+  RgbImage img = random_image(5, 3, 4);
   img.rgb[0] = 2.0f;  // clamped to 1
   img.rgb[1] = -1.0f; // clamped to 0
   write_png(file, img);

@@ -13,7 +13,9 @@
 #include "scene/scene.h"
 #include "support/lit_plane.h"
 
+#include "support/test_temp_dir.h"
 #include <fmt/format.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,11 +29,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() /
-           ("canopy_env_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-  std::filesystem::create_directories(d);
-  return d;
+  return test::test_temp_dir("env");
 }
 
 // An environment light with frame (x, y, z) = world axes.

@@ -15,6 +15,8 @@
 #include "support/lit_plane.h"
 #include "texture.h"
 
+#include "support/test_temp_dir.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -30,11 +32,7 @@ namespace {
 constexpr float kPi = 3.14159265358979323846f;
 
 std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() /
-           ("canopy_tex_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-  std::filesystem::create_directories(d);
-  return d;
+  return test::test_temp_dir("tex");
 }
 
 // A texture over host texels (row 0 on top), scale 1, identity uv mapping.
