@@ -203,6 +203,41 @@ TEST(AutoSampler, TheChoiceIsTheMostEfficientUnlessALighterTailOrACheaperIsNotSi
   EXPECT_EQ(choose_candidate(c, &reason), 0u);
 }
 
+// The emitter pixels' variance is pooled over the candidates: two films alike but for one huge
+// sample at a pixel whose camera rays saw an emitter measure the same variance with pooling, and
+// that variance is the pooled mean of the pixel's two values; without pooling they differ.
+TEST(AutoSampler, TheEmitterPixelsVarianceIsPooledOverTheCandidates) {
+  auto film = [](double outlier) {
+    Film f;
+    f.width = f.film_width = 16;
+    f.height = f.film_height = 16;
+    const size_t n = 16 * 16;
+    f.sum.assign(n, double4{2.0, 2.0, 2.0, 2.0});   // two samples of 1 per pixel
+    f.sumsq.assign(n, double4{2.5, 2.5, 2.5, 2.0}); // sample variance 0.5
+    f.counts.assign(n, double4{});
+    f.sum[37] = double4{outlier + 1.0, outlier + 1.0, outlier + 1.0, 2.0};
+    f.sumsq[37] =
+        double4{outlier * outlier + 1.0, outlier * outlier + 1.0, outlier * outlier + 1.0, 2.0};
+    return f;
+  };
+  const std::vector<Film> films = {film(1000.0), film(3.0)};
+  std::vector<uint8_t> in_view(16 * 16, 0);
+  in_view[37] = 1;
+  const std::vector<double> pooled = pooled_emitter_variance(films, in_view);
+  ASSERT_EQ(pooled.size(), 64u);
+  const int tile = (37 / 16 * 8 / 16) * 8 + (37 % 16) * 8 / 16; // the tile of pixel (5, 2)
+  const double va = 999.0 * 999.0 / 2.0, vb = 2.0 * 2.0 / 2.0;
+  EXPECT_DOUBLE_EQ(pooled[size_t(tile)], 0.5 * (va + vb));
+  EXPECT_TRUE(std::isnan(pooled[0]));
+  const std::vector<uint8_t> off_mean = in_view;
+  const ExploreStats a = explore_stats(films[0], off_mean, -1, &in_view, &pooled);
+  const ExploreStats b = explore_stats(films[1], off_mean, -1, &in_view, &pooled);
+  EXPECT_DOUBLE_EQ(a.variance, b.variance);
+  EXPECT_DOUBLE_EQ(a.variance, (255 * 0.5 + 0.5 * (va + vb)) / 256.0);
+  EXPECT_GT(explore_stats(films[0], off_mean, -1).variance,
+            100.0 * explore_stats(films[1], off_mean, -1).variance);
+}
+
 // Power sampling is hopeless here: the exploration must see it, its samples must weigh little,
 // every pixel gets exactly spp samples, and the renderer ends on the chosen candidate.
 TEST(AutoSampler, TheExplorationRanksByEfficiencyAndItsSamplesArePartOfTheImage) {

@@ -81,7 +81,38 @@ int half_of(const Film& f, size_t p) {
 
 } // namespace
 
-ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half) {
+namespace {
+
+// A pixel's sample variance per sample, the mean over its three channels (k > 1 samples).
+double pixel_variance(const Film& film, size_t p) {
+  const double k = film.sum[p].w;
+  const double s[3] = {film.sum[p].x, film.sum[p].y, film.sum[p].z};
+  const double q[3] = {film.sumsq[p].x, film.sumsq[p].y, film.sumsq[p].z};
+  double v = 0.0;
+  for (int c = 0; c < 3; ++c)
+    v += std::max(0.0, (q[c] - s[c] * s[c] / k) / (k - 1.0)) / 3.0;
+  return v;
+}
+
+} // namespace
+
+std::vector<double> pooled_emitter_variance(const std::vector<Film>& films,
+                                            const std::vector<uint8_t>& emitter) {
+  std::vector<double> sum(kTiles * kTiles, 0.0), n(kTiles * kTiles, 0.0);
+  for (const Film& f : films)
+    for (size_t p = 0; p < f.sum.size(); ++p)
+      if (emitter[p] && f.sum[p].w > 1.0) {
+        const int t = tile_of(f, p);
+        sum[size_t(t)] += pixel_variance(f, p);
+        n[size_t(t)] += 1.0;
+      }
+  for (size_t t = 0; t < sum.size(); ++t)
+    sum[t] = n[t] > 0.0 ? sum[t] / n[t] : std::numeric_limits<double>::quiet_NaN();
+  return sum;
+}
+
+ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half,
+                           const std::vector<uint8_t>* in_view, const std::vector<double>* pooled) {
   std::vector<double> tile_sum(kTiles * kTiles, 0.0), tile_n(kTiles * kTiles, 0.0), v;
   double mean = 0.0, mean_var = 0.0;
   size_t clear = 0;
@@ -94,12 +125,11 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
     const double k = film.sum[p].w;
     if (!(k > 1.0)) continue;
     const double s[3] = {film.sum[p].x, film.sum[p].y, film.sum[p].z};
-    const double q[3] = {film.sumsq[p].x, film.sumsq[p].y, film.sumsq[p].z};
-    double vp = 0.0;
-    for (int c = 0; c < 3; ++c)
-      vp += std::max(0.0, (q[c] - s[c] * s[c] / k) / (k - 1.0)) / 3.0;
-    v.push_back(vp);
     const int t = tile_of(film, p);
+    double vp = pixel_variance(film, p);
+    if (in_view && pooled && (*in_view)[p] && std::isfinite((*pooled)[size_t(t)]))
+      vp = (*pooled)[size_t(t)];
+    v.push_back(vp);
     tile_sum[size_t(t)] += vp;
     tile_n[size_t(t)] += 1.0;
     if (any_clear && emitter[p]) continue;
@@ -384,11 +414,17 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     off_mean[p] = emitter[p] || !common;
   }
   if (!any_common) off_mean = emitter;
+  // The pixels whose camera rays saw an emitter: their variance is the emitters' antialiasing,
+  // the same per sample for every candidate (the same camera samples) but, from a few samples, a
+  // handful of huge values that fall on one candidate's pixels or another's by chance (a tiny,
+  // bright light in view: nearly all of a candidate's measured variance on Veach's MIS scene). It
+  // is measured once, pooled over the candidates per tile, and each candidate counts that.
+  const std::vector<double> pooled = pooled_emitter_variance(films, emitter);
   std::vector<ExploreStats> halves[2];
   for (size_t i = 0; i < cand.size(); ++i) {
-    cand[i].stats = explore_stats(films[i], off_mean, -1);
+    cand[i].stats = explore_stats(films[i], off_mean, -1, &emitter, &pooled);
     for (int h = 0; h < 2; ++h)
-      halves[h].push_back(explore_stats(films[i], off_mean, h));
+      halves[h].push_back(explore_stats(films[i], off_mean, h, &emitter, &pooled));
   }
   // Half h's samples are weighted by the other half's measurements.
   for (int h = 0; h < 2; ++h) {

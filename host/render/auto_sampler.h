@@ -41,7 +41,18 @@ struct ExploreStats {
 // checkerboard of 8 x 8 tiles over the film) or over all (-1). `emitter` marks the pixels left out
 // of the image mean: those whose camera rays saw an emitter (in any candidate's samples), or that
 // not every candidate explored.
-ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half);
+// With `in_view` and `pooled` (pooled_emitter_variance), a pixel marked in `in_view` counts its
+// tile's pooled variance instead of its own.
+ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half,
+                           const std::vector<uint8_t>* in_view = nullptr,
+                           const std::vector<double>* pooled = nullptr);
+
+// Per tile of the film (8 x 8), the mean sample variance of the pixels marked in `emitter` (those
+// whose camera rays saw an emitter) over every film's measured pixels there: the emitters'
+// antialiasing noise, which every candidate shares, measured from all candidates' samples. NaN
+// for a tile without such a pixel.
+std::vector<double> pooled_emitter_variance(const std::vector<Film>& films,
+                                            const std::vector<uint8_t>& emitter);
 
 struct PilotResult {
   std::string label; // the candidate, as `canopy converge` names it (e.g. brdf-mis/split=0.25)
