@@ -10,6 +10,7 @@
 #include "scene/pbrt_reader.h"
 #include "scene/scene.h"
 #include "support/lit_plane.h"
+#include "support/test_lights.h"
 
 #include <gtest/gtest.h>
 
@@ -20,15 +21,6 @@ using namespace canopy;
 namespace {
 
 constexpr float kPi = 3.14159265358979323846f;
-
-Light distant_light(float3 travel, float3 E) {
-  Light l{};
-  l.type = LIGHT_DISTANT;
-  l.e1 = f4_from3(normalize(travel) * -1.0f, 0.0f);
-  l.emission = f4_from3(E, 0.0f);
-  l.prim = -1;
-  return l;
-}
 
 // A 100 x 100 plane at z = 0 seen from above; `fov` degrees.
 Scene plane_scene(MaterialDesc m, float fov) {
@@ -56,7 +48,7 @@ TEST(DistantLight, DiffusePlaneIsExactForEverySampler) {
   for (const char* sampler : kSamplers)
     for (int depth : {1, 2}) {
       Scene scene = plane_scene(diffuse_material("white", rho), 40.0f);
-      scene.infinite_lights.push_back(distant_light(travel, E));
+      scene.infinite_lights.push_back(test::distant_light(travel, E));
       Film film = render(scene, sampler, 4, depth);
       const float3 expect = rho * E * (cos_t / kPi);
       for (size_t p = 0; p < film.sum.size(); ++p) {
@@ -68,7 +60,7 @@ TEST(DistantLight, DiffusePlaneIsExactForEverySampler) {
       }
     }
   Scene scene = plane_scene(diffuse_material("white", rho), 40.0f);
-  scene.infinite_lights.push_back(distant_light(travel, E));
+  scene.infinite_lights.push_back(test::distant_light(travel, E));
   Film film = render(scene, "bsdf", 4);
   for (const double4& s : film.sum)
     EXPECT_EQ(s.x + s.y + s.z, 0.0);
@@ -84,9 +76,10 @@ TEST(DistantLight, SumsWithTheTreeLightsExactly) {
   const float3 I = make_float3(4.0f, 4.0f, 4.0f), pl = make_float3(0.2f, 0.1f, 1.5f);
   for (const char* sampler : kSamplers) {
     Scene scene = plane_scene(diffuse_material("grey", rho), 1.0f); // narrow: x barely varies
-    scene.infinite_lights.push_back(distant_light(t1, E1));
-    scene.infinite_lights.push_back(distant_light(t2, E2));
-    scene.infinite_lights.push_back(distant_light(make_float3(0, 0, 1), E2 * 100.0f)); // below
+    scene.infinite_lights.push_back(test::distant_light(t1, E1));
+    scene.infinite_lights.push_back(test::distant_light(t2, E2));
+    scene.infinite_lights.push_back(
+        test::distant_light(make_float3(0, 0, 1), E2 * 100.0f)); // below
     Light point{};
     point.type = LIGHT_POINT;
     point.p = f4_from3(pl, 0.0f);
@@ -126,7 +119,7 @@ TEST(DistantLight, GlossyPlaneMatchesTheBrdfForEverySampler) {
                                          make_float3(3.983f, 2.385f, 1.603f));
   for (const char* sampler : kSamplers) {
     Scene scene = plane_scene(gold, 20.0f);
-    scene.infinite_lights.push_back(distant_light(travel, E));
+    scene.infinite_lights.push_back(test::distant_light(travel, E));
     Film film = render(scene, sampler, 64);
     CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
     const Material m = scene.materials[0].gpu;
@@ -180,7 +173,7 @@ TEST(DistantLight, CastsAShadow) {
   scene.triangle_light.insert(scene.triangle_light.end(), {-1, -1});
   // Light from +x above: the shadow falls on x in [-1.5, -0.5]. The camera sits below the
   // occluder, looking straight down at x = -1.
-  scene.infinite_lights.push_back(distant_light(make_float3(-1.0f, 0.0f, -1.0f), E));
+  scene.infinite_lights.push_back(test::distant_light(make_float3(-1.0f, 0.0f, -1.0f), E));
   scene.camera.position = make_float3(-1.0f, 0.0f, 0.5f);
   scene.camera.look_at = make_float3(-1.0f, 0.0f, 0.0f);
   Film film = render(scene, "tree", 4);

@@ -17,6 +17,7 @@
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "support/lit_plane.h"
+#include "support/test_lights.h"
 
 #include <gtest/gtest.h>
 
@@ -28,24 +29,6 @@ using namespace canopy;
 namespace {
 
 constexpr float kPi = 3.14159265358979323846f;
-
-Light sun_light(float3 travel, float3 E) {
-  Light sun{};
-  sun.type = LIGHT_DISTANT;
-  sun.e1 = f4_from3(normalize(travel) * -1.0f, 0.0f);
-  sun.emission = f4_from3(E, 0.0f);
-  sun.prim = -1;
-  return sun;
-}
-
-Light point_light(float3 p, float3 I) {
-  Light l{};
-  l.type = LIGHT_POINT;
-  l.p = f4_from3(p, 0.0f);
-  l.emission = f4_from3(I, 0.0f);
-  l.prim = -1;
-  return l;
-}
 
 // Pixel p's mean and the standard error of its red channel (k = 0), green (1) or blue (2).
 void pixel_stats(const Film& f, size_t p, int k, double* mean, double* se) {
@@ -76,7 +59,7 @@ TEST(RenderMix, PlateOfTwoDiffuseMaterialsIsTheAmountWeightedMean) {
     Scene scene = test::lit_plane_scene(mix_material("mix", 1, 2, amount), 20.0f, 1.0f, 24, 24);
     scene.materials.push_back(diffuse_material("A", A));
     scene.materials.push_back(diffuse_material("B", B));
-    scene.infinite_lights.push_back(sun_light(travel, E));
+    scene.infinite_lights.push_back(test::distant_light(travel, E));
     Film film = test::render_lit_plane(scene, sampler, 64);
     const float a = A.x * E.x * cos_t / kPi, b = B.x * E.x * cos_t / kPi;
     const double expect = (1.0 - amount) * a + amount * b;
@@ -111,7 +94,7 @@ TEST(RenderMix, CheckerboardSquaresAreExactUnderTheSun) {
   scene.textures[2].kind = TEXTURE_CHECKERBOARD;
   scene.textures[2].nodes = 3;
   scene.textures[2].uvmap = make_float4(2, 2, 0, 0);
-  scene.infinite_lights.push_back(sun_light(travel, E));
+  scene.infinite_lights.push_back(test::distant_light(travel, E));
   Film film = test::render_lit_plane(scene, "tree", 4);
   CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
   int seen[2] = {0, 0};
@@ -158,8 +141,9 @@ TEST(RenderTransmission, PlateLitFromBehindShowsTOverPi) {
     SCOPED_TRACE(sampler);
     Scene scene =
         test::lit_plane_scene(diffuse_transmission_material("dt", R, T), 20.0f, 1.0f, 16, 16);
-    scene.infinite_lights.push_back(sun_light(up, E_below)); // travels up: lights the far side
-    scene.infinite_lights.push_back(sun_light(down, E_above));
+    scene.infinite_lights.push_back(
+        test::distant_light(up, E_below)); // travels up: lights the far side
+    scene.infinite_lights.push_back(test::distant_light(down, E_above));
     Film film = test::render_lit_plane(scene, sampler, 2);
     const float3 want = (T * E_below * cos_b + R * E_above * cos_a) * (1.0f / kPi);
     for (size_t p = 0; p < film.sum.size(); ++p) {
@@ -184,8 +168,8 @@ TEST(RenderTransmission, PointLightBehindThePlateForEveryLightSampler) {
     SCOPED_TRACE(sampler);
     Scene scene =
         test::lit_plane_scene(diffuse_transmission_material("dt", R, T), 20.0f, 1.0f, 16, 16);
-    scene.lights.push_back(point_light(behind, I_b));
-    scene.lights.push_back(point_light(front, I_f));
+    scene.lights.push_back(test::point_light(behind, I_b));
+    scene.lights.push_back(test::point_light(front, I_f));
     Film film = test::render_lit_plane(scene, sampler, 64);
     CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
     for (int y = 0; y < film.height; ++y)
@@ -266,8 +250,8 @@ TEST(RenderMix, KernelsHoldTheseFeaturesOnlyWhereTheSceneUsesThem) {
   mixed.materials.push_back(diffuse_material("a", make_float3(0.7f, 0.2f, 0.2f)));
   mixed.materials.push_back(diffuse_transmission_material("t", make_float3(0.3f, 0.3f, 0.3f),
                                                           make_float3(0.5f, 0.5f, 0.5f)));
-  mixed.lights.push_back(point_light(make_float3(0.3f, 0.2f, -1.0f), make_float3(3, 3, 3)));
-  mixed.lights.push_back(point_light(make_float3(-0.3f, 0.2f, 1.0f), make_float3(2, 2, 2)));
+  mixed.lights.push_back(test::point_light(make_float3(0.3f, 0.2f, -1.0f), make_float3(3, 3, 3)));
+  mixed.lights.push_back(test::point_light(make_float3(-0.3f, 0.2f, 1.0f), make_float3(2, 2, 2)));
   // The code is gone, not just unused: the program of the plain scene's features is smaller than
   // the same program with the mix or the diffuse-transmission code.
   {

@@ -13,6 +13,7 @@
 #include "render/texture_data.h"
 #include "scene/scene.h"
 #include "support/lit_plane.h"
+#include "support/test_lights.h"
 #include "texture.h"
 
 #include "support/test_temp_dir.h"
@@ -138,15 +139,6 @@ int constant_block(const CameraParams& cam, int x, int y) {
 
 const float3 kBlockColours[4] = {make_float3(0.9f, 0.2f, 0.1f), make_float3(0.1f, 0.8f, 0.3f),
                                  make_float3(0.3f, 0.3f, 0.9f), make_float3(0.6f, 0.6f, 0.05f)};
-
-Light point_light(float3 p, float3 I) {
-  Light l{};
-  l.type = LIGHT_POINT;
-  l.p = f4_from3(p, 0.0f);
-  l.emission = f4_from3(I, 0.0f);
-  l.prim = -1;
-  return l;
-}
 
 } // namespace
 
@@ -368,12 +360,7 @@ TEST(TextureRender, DiffusePlaneUnderTheSunIsExactInsideEachBlock) {
       m.gpu.albedo_texture = 1;
       Scene scene = test::uv_plane_scene(m, 48);
       scene.textures.push_back(texture_desc(file, 3, TEXTURE_MAP_VALUE));
-      Light sun{};
-      sun.type = LIGHT_DISTANT;
-      sun.e1 = f4_from3(normalize(travel) * -1.0f, 0.0f);
-      sun.emission = f4_from3(E, 0.0f);
-      sun.prim = -1;
-      scene.infinite_lights.push_back(sun);
+      scene.infinite_lights.push_back(test::distant_light(travel, E));
       scene.integrator.max_depth = depth;
       Film film = test::render_lit_plane(scene, sampler, 4);
       CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
@@ -425,7 +412,7 @@ TEST(TextureRender, GlossyPlaneTakesTheTexturedAlbedoAndRoughnessEverywhere) {
     Scene scene = test::uv_plane_scene(m, 32);
     scene.textures.push_back(texture_desc(albedo_file, 3, TEXTURE_MAP_VALUE));
     scene.textures.push_back(texture_desc(rough_file, 1, TEXTURE_MAP_ALPHA_SQUARE));
-    scene.lights.push_back(point_light(pl, I));
+    scene.lights.push_back(test::point_light(pl, I));
     // 256 spp: brdf-mis's rare large samples (also on an untextured plane) make the variance of
     // 16 samples an underestimate.
     Film film = test::render_lit_plane(scene, sampler, 256);

@@ -14,12 +14,8 @@ using namespace canopy;
 
 namespace {
 
-const std::string kHead = "Scale -1 1 1\n"
-                          "LookAt 0 0 5  0 0 0  0 1 0\n"
-                          "Camera \"perspective\"\n"
-                          "WorldBegin\n";
-const std::string kTri =
-    "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer indices\" [0 1 2]\n";
+const std::string& kHead = test::kPbrtHead;
+const std::string& kTri = test::kPbrtTriangle;
 
 const Material& material_of(const Scene& s, size_t tri) {
   return s.materials[size_t(s.triangle_material[tri])].gpu;

@@ -34,15 +34,8 @@ std::string error_of(const std::string& text, bool strict = false) {
   return test::pbrt_error_of(text, strict);
 }
 
-// The frames agree with Canopy's (Scale -1 1 1), so the world is kept as written. Three lines: the
-// scene text starts at line 4 with "WorldBegin".
-const std::string kHead = "Scale -1 1 1\n"
-                          "LookAt 0 0 5  0 0 0  0 1 0\n"
-                          "Camera \"perspective\"\n"
-                          "WorldBegin\n";
-
-const std::string kTri =
-    "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer indices\" [0 1 2]\n";
+const std::string& kHead = test::kPbrtHead;
+const std::string& kTri = test::kPbrtTriangle;
 
 const std::string kWood =
     "Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"textures/checker.png\"\n";

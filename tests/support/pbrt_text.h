@@ -10,6 +10,16 @@
 
 namespace canopy::test {
 
+// A camera whose frames agree with Canopy's (Scale -1 1 1), so the world is kept as written, and
+// the start of the world block: scene text after it starts at line 5.
+inline const std::string kPbrtHead = "Scale -1 1 1\n"
+                                     "LookAt 0 0 5  0 0 0  0 1 0\n"
+                                     "Camera \"perspective\"\n"
+                                     "WorldBegin\n";
+// One triangle, with whatever material is current.
+inline const std::string kPbrtTriangle =
+    "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer indices\" [0 1 2]\n";
+
 inline const std::filesystem::path kPbrtData = std::filesystem::path(CANOPY_TEST_DATA_DIR) / "pbrt";
 
 inline Scene load_pbrt(const std::string& text, bool strict = false) {
