@@ -132,15 +132,8 @@ TEST(DistantLight, GlossyPlaneMatchesTheBrdfForEverySampler) {
     int checked = 0;
     for (int y = 0; y < film.height; ++y)
       for (int x = 0; x < film.width; ++x) {
-        float3 ref = make_float3(0, 0, 0), coarse = make_float3(0, 0, 0);
-        for (int a = 0; a < 16; ++a)
-          for (int b = 0; b < 16; ++b)
-            ref += radiance(float(x) + (a + 0.5f) / 16.0f, float(y) + (b + 0.5f) / 16.0f);
-        for (int a = 0; a < 4; ++a)
-          for (int b = 0; b < 4; ++b)
-            coarse += radiance(float(x) + (a + 0.5f) / 4.0f, float(y) + (b + 0.5f) / 4.0f);
-        ref = ref * (1.0f / 256.0f);
-        coarse = coarse * (1.0f / 16.0f);
+        const float3 ref = test::pixel_average(radiance, x, y, 16);
+        const float3 coarse = test::pixel_average(radiance, x, y, 4);
         size_t p = size_t(y) * size_t(film.width) + size_t(x);
         double n = film.sum[p].w;
         double mean = film.sum[p].x / n;

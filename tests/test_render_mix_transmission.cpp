@@ -174,7 +174,7 @@ TEST(RenderTransmission, PointLightBehindThePlateForEveryLightSampler) {
     CameraParams cam = make_camera_params(scene.camera, scene.film.width, scene.film.height);
     for (int y = 0; y < film.height; ++y)
       for (int x = 0; x < film.width; ++x) {
-        auto radiance = [&](float fx, float fy) {
+        auto radiance = [&](float fx, float fy) -> double { // summed in double
           float3 X;
           test::camera_ray_to_plane(cam, fx, fy, &X);
           float3 tb = behind - X, tf = front - X;
@@ -182,15 +182,8 @@ TEST(RenderTransmission, PointLightBehindThePlateForEveryLightSampler) {
           return T.x / kPi * I_b.x * std::fabs(tb.z) / (db * std::sqrt(db)) +
                  R.x / kPi * I_f.x * tf.z / (df * std::sqrt(df));
         };
-        double ref = 0.0, coarse = 0.0;
-        for (int a = 0; a < 16; ++a)
-          for (int c = 0; c < 16; ++c)
-            ref += radiance(float(x) + (a + 0.5f) / 16.0f, float(y) + (c + 0.5f) / 16.0f);
-        for (int a = 0; a < 4; ++a)
-          for (int c = 0; c < 4; ++c)
-            coarse += radiance(float(x) + (a + 0.5f) / 4.0f, float(y) + (c + 0.5f) / 4.0f);
-        ref /= 256.0;
-        coarse /= 16.0;
+        const double ref = test::pixel_average(radiance, x, y, 16);
+        const double coarse = test::pixel_average(radiance, x, y, 4);
         const size_t p = size_t(y) * size_t(film.width) + size_t(x);
         double mean, se;
         pixel_stats(film, p, 0, &mean, &se);

@@ -434,15 +434,8 @@ TEST(TextureRender, GlossyPlaneTakesTheTexturedAlbedoAndRoughnessEverywhere) {
           float3 wi = to * (1.0f / std::sqrt(d2));
           return bsdf_eval(&mb, d * -1.0f, wi) * I * (wi.z / d2);
         };
-        float3 ref = make_float3(0, 0, 0), coarse = make_float3(0, 0, 0);
-        for (int a = 0; a < 16; ++a)
-          for (int c = 0; c < 16; ++c)
-            ref += radiance(float(x) + (a + 0.5f) / 16.0f, float(y) + (c + 0.5f) / 16.0f);
-        for (int a = 0; a < 4; ++a)
-          for (int c = 0; c < 4; ++c)
-            coarse += radiance(float(x) + (a + 0.5f) / 4.0f, float(y) + (c + 0.5f) / 4.0f);
-        ref = ref * (1.0f / 256.0f);
-        coarse = coarse * (1.0f / 16.0f);
+        const float3 ref = test::pixel_average(radiance, x, y, 16);
+        const float3 coarse = test::pixel_average(radiance, x, y, 4);
         size_t p = size_t(y) * size_t(film.width) + size_t(x);
         double n = film.sum[p].w;
         double comps[3][3] = {{film.sum[p].x, film.sumsq[p].x, ref.x - coarse.x},

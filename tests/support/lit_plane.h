@@ -16,6 +16,17 @@
 
 namespace canopy::test {
 
+// The mean of f(fx, fy) over pixel (x, y) by the midpoint rule on an n x n grid (f: a float3 or a
+// double of film coordinates). A test's reference is the 16 x 16 mean, and its difference from the
+// 4 x 4 mean bounds the rule's error.
+template <class F> auto pixel_average(const F& f, int x, int y, int n) {
+  decltype(f(0.0f, 0.0f)) sum{};
+  for (int a = 0; a < n; ++a)
+    for (int c = 0; c < n; ++c)
+      sum += f(float(x) + (float(a) + 0.5f) / float(n), float(y) + (float(c) + 0.5f) / float(n));
+  return sum * (1.0f / float(n * n));
+}
+
 // A (2 half) x (2 half) square of material m at z = 0, the camera at (0.3, -0.2, 5) looking at the
 // origin with a vertical field of fov degrees, a width x height film, direct light (max_depth 1).
 inline Scene lit_plane_scene(MaterialDesc m, float fov, float half, int width, int height) {
