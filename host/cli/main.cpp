@@ -488,12 +488,14 @@ int run_render(const RenderArgs& args) {
              {"samples", c.samples},
              {"variance", c.stats.variance},
              {"variance_interval", {c.stats.variance_lo, c.stats.variance_hi}},
+             {"emitter_variance", c.stats.emitter_variance},
              {"tail_share", c.stats.tail_share},
              {"seconds", c.seconds},
              {"pass_seconds", c.pass_seconds},
              {"efficiency", c.efficiency},
              {"efficiency_lo", c.efficiency_lo},
              {"missed_tail", bool(c.missed_tail)},
+             {"pruned", bool(c.pruned)},
              {"weight", {c.weight[0], c.weight[1]}}});
       j["auto"] = a;
     }

@@ -111,10 +111,14 @@ std::vector<double> pooled_emitter_variance(const std::vector<Film>& films,
   return sum;
 }
 
+double emitter_variance_scale(const std::string& path_sampler, int spp) {
+  return path_sampler == "sobol" ? 1.0 / std::sqrt(double(std::max(1, spp))) : 1.0;
+}
+
 ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half,
                            const std::vector<uint8_t>* in_view, const std::vector<double>* pooled) {
   std::vector<double> tile_sum(kTiles * kTiles, 0.0), tile_n(kTiles * kTiles, 0.0), v;
-  double mean = 0.0, mean_var = 0.0;
+  double mean = 0.0, mean_var = 0.0, in_view_sum = 0.0;
   size_t clear = 0;
   bool any_clear = false;
   for (size_t p = 0; p < film.sum.size(); ++p)
@@ -127,8 +131,10 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
     const double s[3] = {film.sum[p].x, film.sum[p].y, film.sum[p].z};
     const int t = tile_of(film, p);
     double vp = pixel_variance(film, p);
-    if (in_view && pooled && (*in_view)[p] && std::isfinite((*pooled)[size_t(t)]))
+    if (in_view && pooled && (*in_view)[p] && std::isfinite((*pooled)[size_t(t)])) {
       vp = (*pooled)[size_t(t)];
+      in_view_sum += vp;
+    }
     v.push_back(vp);
     tile_sum[size_t(t)] += vp;
     tile_n[size_t(t)] += 1.0;
@@ -142,6 +148,7 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   const double total = std::accumulate(v.begin(), v.end(), 0.0);
   const double n = double(v.size());
   st.variance = total / n;
+  st.emitter_variance = in_view_sum / n;
   // The ratio estimate's standard error over the T tiles of the half: the tiles' pixel variances
   // are not identically distributed, so this is conservative for the mean.
   double dev = 0.0, tiles = 0.0;
@@ -207,12 +214,12 @@ bool significantly_less(const ExploreStats& a, double ka, const ExploreStats& b,
 } // namespace
 
 size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
-  std::vector<ExploreStats> stats;
+  std::vector<ExploreStats> stats; // of the candidates not pruned
   for (const PilotResult& p : c)
-    stats.push_back(p.stats);
+    if (!p.pruned) stats.push_back(p.stats);
   const std::vector<bool> missed = missed_tails(stats);
-  for (size_t i = 0; i < c.size(); ++i) {
-    c[i].missed_tail = missed[i];
+  for (size_t i = 0, k = 0; i < c.size(); ++i) {
+    c[i].missed_tail = !c[i].pruned && missed[k++];
     const double t = c[i].pass_seconds, v = c[i].stats.variance;
     c[i].efficiency = v > 0.0 && t > 0.0 ? 1.0 / (v * t) : 0.0;
     c[i].efficiency_lo = c[i].stats.variance_hi > 0.0 && t > 0.0
@@ -222,14 +229,16 @@ size_t choose_candidate(std::vector<PilotResult>& c, std::string* reason) {
                              ? 1.0 / (c[i].stats.variance_lo * t)
                              : std::numeric_limits<double>::infinity();
   }
-  auto ranked = [&](size_t i) { return !c[i].missed_tail && c[i].efficiency > 0.0; };
+  auto ranked = [&](size_t i) {
+    return !c[i].pruned && !c[i].missed_tail && c[i].efficiency > 0.0;
+  };
   size_t best = c.size();
   for (size_t i = 0; i < c.size(); ++i)
     if (ranked(i) && (best == c.size() || c[i].efficiency > c[best].efficiency)) best = i;
   if (best == c.size()) { // nothing measured: the fastest
     best = 0;
     for (size_t i = 1; i < c.size(); ++i)
-      if (c[i].pass_seconds < c[best].pass_seconds) best = i;
+      if (!c[i].pruned && c[i].pass_seconds < c[best].pass_seconds) best = i;
     *reason = "no variance measured: the fastest";
     return best;
   }
@@ -269,6 +278,10 @@ std::vector<double> exploration_weights(std::vector<PilotResult> other) {
   const size_t ref = choose_candidate(other, &reason);
   std::vector<double> w(other.size(), 0.0);
   for (size_t i = 0; i < other.size(); ++i) {
+    if (other[i].pruned) { // its probe's samples: as good as any unbiased estimator's
+      w[i] = 1.0;
+      continue;
+    }
     if (other[i].missed_tail) continue;
     // The typical tile's excess, the median over tiles of the variance ratio to the predicted
     // choice: the image's variance can be a few pixels' (the edges of small bright emitters in
@@ -301,8 +314,95 @@ RowBands exploration_bands(int width, int height, int period) {
   return b;
 }
 
+bool may_beat(double emitter_variance, double pass_seconds, double best_efficiency) {
+  return emitter_variance * pass_seconds * best_efficiency < 1.0;
+}
+
+namespace {
+
+// Sample indices [first, first + spp) on bands of rows, which the chosen candidate renders.
+struct Gap {
+  RowBands bands;
+  int first = 0, spp = 0;
+};
+
+// The bands of a period that `b` (count 1, first 0) does not cover.
+RowBands other_bands(RowBands b) {
+  b.first += b.count;
+  b.count = b.period - b.count;
+  return b;
+}
+
+// A candidate's rows `b` (count 1) in kProbeParts parts, each one band in kProbeParts of its:
+// the probe first; empty when the probe would cover none of the film's `rows`.
+std::vector<RowBands> probe_parts(const RowBands& b, int rows) {
+  std::vector<RowBands> parts;
+  for (int j = 0; j < kProbeParts; ++j)
+    parts.push_back(RowBands{b.height, kProbeParts * b.period, b.first + j * b.period, 1});
+  if (b.count != 1 || covered_rows(parts[0].packed(), rows) == 0) parts.clear();
+  return parts;
+}
+
+// The candidates' measurements from their exploration films, over the film and over each half.
+struct Measured {
+  std::vector<ExploreStats> film, half[2];
+};
+
+Measured measure(const std::vector<Film>& films, double emitter_scale) {
+  Measured m;
+  if (films.empty()) return m;
+  // The image means compare over the same pixels: those no candidate's camera rays saw an emitter
+  // at, and that every candidate explored (a banded candidate's rows show another part of the
+  // image than the film's mean); on interleaved rows, where no pixel is common, each over its own
+  // rows.
+  std::vector<uint8_t> emitter(films[0].sum.size(), 0), off_mean(emitter.size(), 0);
+  bool any_common = false;
+  for (size_t p = 0; p < emitter.size(); ++p) {
+    bool common = true;
+    for (const Film& f : films) {
+      emitter[p] |= f.counts[p].z > 0.0 ? 1 : 0;
+      common = common && f.sum[p].w > 1.0;
+    }
+    any_common = any_common || common;
+    off_mean[p] = emitter[p] || !common;
+  }
+  if (!any_common) off_mean = emitter;
+  // The pixels whose camera rays saw an emitter: their variance is the emitters' antialiasing,
+  // the same per sample for every candidate (the same camera samples) but, from a few samples, a
+  // handful of huge values that fall on one candidate's pixels or another's by chance (a tiny,
+  // bright light in view: nearly all of a candidate's measured variance on Veach's MIS scene). It
+  // is measured once, pooled over the candidates per tile, and each candidate counts that, scaled
+  // to what the render's spp will show of it (emitter_variance_scale).
+  std::vector<double> pooled = pooled_emitter_variance(films, emitter);
+  for (double& v : pooled)
+    v *= emitter_scale;
+  for (const Film& f : films) {
+    m.film.push_back(explore_stats(f, off_mean, -1, &emitter, &pooled));
+    for (int h = 0; h < 2; ++h)
+      m.half[h].push_back(explore_stats(f, off_mean, h, &emitter, &pooled));
+  }
+  return m;
+}
+
+// Whether candidate `i`, at `pass_seconds` per pass, may be more efficient than the most efficient
+// of the candidates before it (measured `m`) that did not miss their tail.
+bool may_beat_explored(const std::vector<PilotResult>& cand, size_t i, const Measured& m,
+                       double pass_seconds) {
+  const std::vector<bool> missed = missed_tails(m.film);
+  double best = 0.0, floor = 0.0;
+  for (size_t j = 0; j < std::min(i, m.film.size()); ++j) {
+    const double e = m.film[j].variance > 0.0 && cand[j].pass_seconds > 0.0
+                         ? 1.0 / (m.film[j].variance * cand[j].pass_seconds)
+                         : 0.0;
+    if (!missed[j] && e > best) best = e, floor = m.film[j].emitter_variance;
+  }
+  return best == 0.0 || may_beat(floor, pass_seconds, best);
+}
+
+} // namespace
+
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
-                       const RenderSettings& settings, int explore_period) {
+                       const RenderSettings& settings, int explore_period, double probe_cost) {
   const auto t0 = Clock::now();
   AutoRender out;
   AutoChoice& choice = out.choice;
@@ -364,21 +464,62 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   // The exploration: per candidate, one untimed pass (PoCL loads a kernel at its first launch,
   // and the first render allocates the wave's buffers and touches the scene's memory), then
   // `renders` timed renders of its passes.
-  // The faster gives the time per pass (robust to a moment of other load on the machine).
-  int next = settings.first_sample;
+  // The faster gives the time per pass (robust to a moment of other load on the machine). The
+  // last, costly candidate's first pass starts with its probe (kProbeParts), timed.
+  const double emitter_scale = emitter_variance_scale(base.path_sampler, settings.spp);
+  int next = settings.first_sample, explored_end = next;
   std::vector<Film> films;
+  std::vector<Gap> gaps; // what the exploration leaves on some rows for the chosen candidate
   for (size_t i = 0; i < cand.size(); ++i) {
     PilotResult& c = cand[i];
     if (!same_sampler(renderer.options(), c.options)) renderer.set_light_sampler(c.options);
-    rs.bands = c.bands;
     if (interleaved) next = settings.first_sample; // the same indices, on other rows
     c.first_sample = next;
     rs.first_sample = next;
     rs.spp = 1;
-    const auto first = Clock::now();
-    Film film = renderer.render(rs);
-    // On interleaved rows the untimed pass is the timed passes' size too: the faster counts.
-    const double first_pass = std::chrono::duration<double>(Clock::now() - first).count();
+    const std::vector<RowBands> parts =
+        i + 1 == cand.size() && i > 0 ? probe_parts(c.bands, fh) : std::vector<RowBands>();
+    Film film;
+    double first_pass = 0.0; // seconds of the first pass
+    if (!parts.empty()) {
+      rs.bands = parts[0];
+      const auto start = Clock::now();
+      film = renderer.render(rs);
+      first_pass = probe_cost * std::chrono::duration<double>(Clock::now() - start).count();
+      const double share = double(covered_rows(parts[0].packed(), fh)) / double(fh);
+      if (!may_beat_explored(cand, i, measure(films, emitter_scale), first_pass / share)) {
+        // Its probe is all it renders. The chosen candidate renders the probe's sample index on
+        // the candidate's other rows, and the indices it would have rendered after.
+        c.pruned = true;
+        c.pass_seconds = first_pass / share;
+        c.seconds = first_pass;
+        c.samples = 1;
+        c.explored_share = share;
+        for (size_t j = 1; j < parts.size(); ++j)
+          gaps.push_back({parts[j], c.first_sample, 1});
+        if (interleaved)
+          gaps.push_back({c.bands, c.first_sample + 1, 1});
+        else if (!c.bands.all())
+          gaps.push_back({other_bands(c.bands), c.first_sample, 1});
+        c.bands = parts[0];
+        explored_end = std::max(explored_end, ++next);
+        films.push_back(std::move(film));
+        continue;
+      }
+      for (size_t j = 1; j < parts.size(); ++j) { // the rest of its first pass
+        if (covered_rows(parts[j].packed(), fh) == 0) continue;
+        rs.bands = parts[j];
+        const auto part = Clock::now();
+        add_samples(film, renderer.render(rs));
+        first_pass += std::chrono::duration<double>(Clock::now() - part).count();
+      }
+    } else {
+      rs.bands = c.bands;
+      const auto start = Clock::now();
+      film = renderer.render(rs);
+      first_pass = std::chrono::duration<double>(Clock::now() - start).count();
+    }
+    rs.bands = c.bands;
     next += 1;
     rs.spp = passes[i];
     for (int r = 0; r < renders; ++r) {
@@ -392,39 +533,23 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       add_samples(film, f);
       next += passes[i];
     }
+    // On interleaved rows the untimed pass is the timed passes' size too: the faster counts.
     if (interleaved) c.pass_seconds = std::min(c.pass_seconds, first_pass / c.explored_share);
     c.samples = next - c.first_sample;
+    explored_end = std::max(explored_end, next);
+    if (!interleaved && !c.bands.all()) // the chosen one renders its indices on the other bands
+      gaps.push_back({other_bands(c.bands), c.first_sample, c.samples});
     films.push_back(std::move(film));
   }
-  choice.explored_samples = next - settings.first_sample;
+  choice.explored_samples = explored_end - settings.first_sample;
 
-  // Measurements over the film and over each half. The image means compare over the same pixels:
-  // those no candidate's camera rays saw an emitter at, and that every candidate explored (a
-  // banded candidate's rows show another part of the image than the film's mean); on interleaved
-  // rows, where no pixel is common, each over its own rows.
-  std::vector<uint8_t> emitter(films[0].sum.size(), 0), off_mean(emitter.size(), 0);
-  bool any_common = false;
-  for (size_t p = 0; p < emitter.size(); ++p) {
-    bool common = true;
-    for (const Film& f : films) {
-      emitter[p] |= f.counts[p].z > 0.0 ? 1 : 0;
-      common = common && f.sum[p].w > 1.0;
-    }
-    any_common = any_common || common;
-    off_mean[p] = emitter[p] || !common;
-  }
-  if (!any_common) off_mean = emitter;
-  // The pixels whose camera rays saw an emitter: their variance is the emitters' antialiasing,
-  // the same per sample for every candidate (the same camera samples) but, from a few samples, a
-  // handful of huge values that fall on one candidate's pixels or another's by chance (a tiny,
-  // bright light in view: nearly all of a candidate's measured variance on Veach's MIS scene). It
-  // is measured once, pooled over the candidates per tile, and each candidate counts that.
-  const std::vector<double> pooled = pooled_emitter_variance(films, emitter);
+  // Measurements over the film and over each half.
+  const Measured m = measure(films, emitter_scale);
   std::vector<ExploreStats> halves[2];
   for (size_t i = 0; i < cand.size(); ++i) {
-    cand[i].stats = explore_stats(films[i], off_mean, -1, &emitter, &pooled);
+    cand[i].stats = m.film[i];
     for (int h = 0; h < 2; ++h)
-      halves[h].push_back(explore_stats(films[i], off_mean, h, &emitter, &pooled));
+      halves[h].push_back(m.half[h][i]);
   }
   // Half h's samples are weighted by the other half's measurements.
   for (int h = 0; h < 2; ++h) {
@@ -443,20 +568,18 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   choice.pilot_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
   // The chosen candidate renders the rest: the samples after the exploration's everywhere, and
-  // the samples of a candidate that explored on bands of rows on the other rows. Its samples share
-  // what is left of each pixel's mass: (spp - sum of the exploration's weighted samples) / (its
-  // samples), at least 1 each.
+  // the gaps: the sample indices of a candidate that explored on bands of rows on the other rows,
+  // and those a pruned candidate did not render. Its samples share what is left of each pixel's
+  // mass: (spp - sum of the exploration's weighted samples) / (its samples), at least 1 each.
   rs = settings;
-  rs.first_sample = next;
-  rs.spp = settings.first_sample + settings.spp - next;
+  rs.first_sample = explored_end;
+  rs.spp = settings.first_sample + settings.spp - explored_end;
   Film rest = renderer.render(rs);
-  for (const PilotResult& c : cand) {
-    if (c.bands.all() || interleaved) continue; // interleaved: the candidates cover every row
-    rs.first_sample = c.first_sample;
-    rs.spp = c.samples;
-    rs.bands = c.bands;
-    rs.bands.first = c.bands.first + c.bands.count; // the other bands of the period
-    rs.bands.count = c.bands.period - c.bands.count;
+  for (const Gap& g : gaps) {
+    if (covered_rows(g.bands.packed(), fh) == 0) continue;
+    rs.first_sample = g.first;
+    rs.spp = g.spp;
+    rs.bands = g.bands;
     add_samples(rest, renderer.render(rs));
   }
   // A candidate's weight at a pixel: 1 where another candidate's camera rays saw an emitter there
@@ -501,7 +624,9 @@ std::string describe(const AutoChoice& choice) {
         "{:.2g}/{:.2g}){}",
         i ? "," : "", c.label, c.efficiency, c.efficiency_lo, c.efficiency_hi, c.pass_seconds,
         100.0 * c.explored_share, c.stats.tail_share, c.weight[0], c.weight[1],
-        c.missed_tail ? " (missed its tail: not ranked)" : "");
+        c.missed_tail ? " (missed its tail: not ranked)"
+        : c.pruned    ? " (its probe: it could not be the most efficient)"
+                      : "");
   }
   return s + ")";
 }

@@ -27,6 +27,9 @@ struct ExploreStats {
   double variance = 0.0, variance_lo = 0.0, variance_hi = 0.0;
   // The share of the summed pixel variance held by the worst 0.1% of pixels (at least one).
   double tail_share = 0.0;
+  // The part of `variance` from the pixels whose camera rays saw an emitter (counted with the
+  // pooled variance): the emitters' antialiasing noise, which every candidate has.
+  double emitter_variance = 0.0;
   // Over the pixels whose camera rays saw no emitter: the image's mean value and that mean's
   // variance (the missed-tail test).
   double mean = 0.0, mean_variance = 0.0;
@@ -42,7 +45,7 @@ struct ExploreStats {
 // of the image mean: those whose camera rays saw an emitter (in any candidate's samples), or that
 // not every candidate explored.
 // With `in_view` and `pooled` (pooled_emitter_variance), a pixel marked in `in_view` counts its
-// tile's pooled variance instead of its own.
+// tile's pooled variance instead of its own, and adds it to emitter_variance.
 ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half,
                            const std::vector<uint8_t>* in_view = nullptr,
                            const std::vector<double>* pooled = nullptr);
@@ -53,6 +56,16 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
 // for a tile without such a pixel.
 std::vector<double> pooled_emitter_variance(const std::vector<Film>& films,
                                             const std::vector<uint8_t>& emitter);
+
+// The emitters' antialiasing error in a render of `spp` samples per pixel, relative to what their
+// per-sample variance predicts (variance / spp): 1 with independent camera samples (path sampler
+// "independent"). With stratified ones ("sobol") an edge in the pixel falls faster: the variance
+// of Owen-scrambled points on a discontinuity falls as spp^-3/2, so the factor is spp^-1/2
+// (measured on Veach's MIS scene, docs/design.md "Choosing the estimator per scene"). The
+// estimator choice scales the pooled emitter variance by it: measured per sample from two
+// samples, that noise otherwise counts several times what the user's render will show, and
+// pushes the choice to the cheapest candidate.
+double emitter_variance_scale(const std::string& path_sampler, int spp);
 
 struct PilotResult {
   std::string label; // the candidate, as `canopy converge` names it (e.g. brdf-mis/split=0.25)
@@ -68,6 +81,9 @@ struct PilotResult {
   // Its image mean is far below the others': it missed rare large samples, so its measured
   // variance is too low. Not ranked, and its samples weigh nothing.
   bool missed_tail = false;
+  // It rendered its probe only (kProbeParts): it could not be the most efficient. Not ranked;
+  // its samples weigh 1.
+  bool pruned = false;
   // The weight of each of its exploration samples in the two halves of the film (1: as much as a
   // sample of a render of one sampler; see the file comment).
   double weight[2] = {0.0, 0.0};
@@ -108,11 +124,10 @@ std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, 
 // is taken: a heavy tail's variance from a few samples is unreliable); then, the cheapest
 // candidate of at most kCheaperFactor times its time per pass that it does not beat significantly
 // and whose tail is no heavier: its render of the user's spp ends much sooner at no significant
-// loss. "Significantly": the
-// difference of variance x seconds per pass, summed over tiles, exceeds 1.96 standard errors of
-// that sum estimated from the tiles' differences (a paired comparison: the spread between tiles
-// that every candidate shares cancels). Without a measured variance (a black image), the fastest.
-// Sets `reason`.
+// loss. "Significantly": the difference of variance x seconds per pass, summed over tiles,
+// exceeds 1.96 standard errors of that sum estimated from the tiles' differences (a paired
+// comparison: the spread between tiles that every candidate shares cancels). Without a measured
+// variance (a black image), the fastest. Pruned candidates take no part. Sets `reason`.
 size_t choose_candidate(std::vector<PilotResult>& candidates, std::string* reason);
 constexpr double kCheaperFactor = 0.5;
 
@@ -143,15 +158,29 @@ constexpr int kInterleavedMinSpp = 3;
 constexpr int kExploredPixels = 16384;
 RowBands exploration_bands(int width, int height, int period = 0);
 
+// The last candidate is the costly one (a splitting sampler's pass costs 4 to 18 times tree's on
+// the shipped scenes). It first renders its first pass on one in kProbeParts of its rows (the
+// probe), timed, and explores further only if it can still be the most efficient: its variance
+// is at least the emitter pixels' (ExploreStats::emitter_variance, the same for every candidate),
+// so 1 / (that x its time per pass) bounds its efficiency. Where the emitters' antialiasing is
+// most of the error (small, bright lights in view), a costly sample cannot pay, and the probe is
+// all it costs. The probe's samples stay in the image.
+constexpr int kProbeParts = 4;
+// Whether a candidate whose pass takes `pass_seconds` may be more efficient than `best` (1 /
+// (variance x seconds per pass)), when its variance is at least `emitter_variance`.
+bool may_beat(double emitter_variance, double pass_seconds, double best_efficiency);
+
 // Renders samples [settings.first_sample, + settings.spp) of the whole film with the chosen
 // candidate after exploring all, some on bands of rows (exploration_bands(film, explore_period);
 // see the file comment); the film's sums are weighted so that its mean is the
 // unbiased image and its count per pixel is spp. Leaves `renderer` set to the chosen candidate.
 // Below kFilmExplorationMinSpp spp, down to kInterleavedMinSpp, the candidates explore on
 // interleaved rows; below that kFewSamplesCandidate renders it all, and
-// in a window the last candidate.
+// in a window the last candidate. `probe_cost` multiplies the probe's measured time (tests: a
+// candidate as if that many times costlier).
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
-                       const RenderSettings& settings, int explore_period = 0);
+                       const RenderSettings& settings, int explore_period = 0,
+                       double probe_cost = 1.0);
 
 // One line for logs: "auto: tree (exploration 3 of 16 spp in 0.84 s; efficiency power 12.3 (0.05
 // s/pass, weight 0.1), ...)".
