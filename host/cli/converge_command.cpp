@@ -6,6 +6,7 @@
 #include "image/image_io.h"
 #include "oiio/plot.h"
 #include "render/auto_sampler.h"
+#include "render/equal_time.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 
@@ -120,6 +121,8 @@ struct PointStats {
 // A point is resolved when its mean MSE is more than this many times the reference's floor:
 // closer to it, the reference's own noise would be a large part of the measured error.
 constexpr double kResolvedFactor = 10.0;
+// Checks of the equal-time spp by a render at it (spp_for_seconds).
+constexpr int kTimingRefinements = 3;
 
 struct MedianPoint {
   int spp = 0;
@@ -376,32 +379,6 @@ std::vector<PointStats> point_stats(const std::vector<RunRecord>& runs, double f
     out.push_back(p);
   }
   return out;
-}
-
-// The spp for which one render takes about `target` seconds (>= 1, <= max_spp). Render time is
-// close to affine in spp (a fixed cost per render plus a cost per sample), so a first render at
-// `probe` spp that is short against the target is followed by a second one at about half the
-// target, and the line through both is solved for the target. Returns the seconds spent.
-// One render of `spp` samples with seed `seed`; returns its seconds.
-using TimedRender = std::function<double(int spp, uint32_t seed)>;
-
-double spp_for_seconds(const TimedRender& render, double target, int probe, int max_spp,
-                       uint32_t seed, int* spp_out) {
-  auto time_at = [&](int spp) { return std::max(1e-6, render(spp, seed)); };
-  probe = std::clamp(probe, 1, max_spp);
-  double t1 = time_at(probe), spent = t1;
-  double spp = double(probe) * target / t1;
-  if (t1 < 0.25 * target && probe < max_spp) {
-    int p2 = int(
-        std::clamp(std::lround(0.5 * double(probe) * target / t1), long(probe) + 1, long(max_spp)));
-    double t2 = time_at(p2);
-    spent += t2;
-    double slope = (t2 - t1) / double(p2 - probe);
-    double fixed = std::max(0.0, t1 - slope * double(probe));
-    spp = slope > 0.0 ? (target - fixed) / slope : double(p2) * target / t2;
-  }
-  *spp_out = int(std::clamp(std::llround(spp), 1LL, (long long)max_spp));
-  return spent;
 }
 
 // Median RMSE at time t by log-log interpolation of a curve; outside the measured range, the
@@ -813,7 +790,7 @@ int run_converge(const ConvergeArgs& a) {
       // (auto probes from 16 spp: with fewer it has no room to explore).
       res.timing_seconds = spp_for_seconds(
           [&](int spp, uint32_t seed) { return timed_render(ci, spp, seed, nullptr); },
-          a.equal_time, warm_spp, a.max_spp, 0xC0FFEEu + 1, &equal_spp[ci]);
+          a.equal_time, warm_spp, a.max_spp, 0xC0FFEEu + 1, &equal_spp[ci], kTimingRefinements);
       timing = fmt::format(", timing {:.2f} s: {} spp", res.timing_seconds, equal_spp[ci]);
     }
     progress.show(fmt::format("[{}/{}] {:<16} build {:.3f} s (light tree {:.3f} s), compile "
