@@ -24,7 +24,7 @@
 #
 # Method. Per configuration, `canopy converge --equal-time T` builds and warms up the renderer
 # (kernel builds are not timed), chooses the spp for which one render takes about T seconds from
-# timing renders, then renders SEEDS independent seeds at that spp. Per point it reports the mean
+# timing renders (checked by renders at it), then renders SEEDS independent seeds at that spp. Per point it reports the mean
 # MSE over the seeds with a 95% bootstrap interval (2000 resamples, fixed RNG seed), the mean
 # render seconds, efficiency = 1 / (mean MSE x mean seconds) with its bootstrap interval, the share
 # of each image's squared error held by its top 0.1% of pixels (mean and max over seeds) and the

@@ -300,7 +300,7 @@ def main():
     out.append(
         "Method (`canopy converge --equal-time T`, docs/design.md \"Error against time\"): per "
         "configuration, after an unrecorded warm-up render, timing renders choose the spp for "
-        "which one render takes about T seconds; then independent seeds (8 unless the note says "
+        "which one render takes about T seconds (and renders at it check that); then independent seeds (8 unless the note says "
         "otherwise) are rendered at that spp and measured against the reference. Per "
         "configuration: the mean MSE over the seeds with a 95% bootstrap interval (2000 "
         "resamples of the seeds, fixed RNG seed), the mean render seconds, and efficiency = 1 / "
