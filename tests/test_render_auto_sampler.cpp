@@ -400,9 +400,9 @@ TEST_P(CombinedImage, IsUnbiased) {
       const PilotResult& c = r.choice.candidates[i];
       const double share = interleaved || (period > 1 && i == 2) ? 16.0 / 48.0 : 1.0;
       EXPECT_EQ(c.pruned, pruned && i == 2) << describe(r.choice);
-      // a probe: one of kProbeParts bands of its rows (of 16, 8 in the first of 2 bands of 8)
+      // a probe: two of kProbeParts bands of its rows (on bands, both of its 2 bands of 8 rows)
       EXPECT_DOUBLE_EQ(c.explored_share,
-                       c.pruned ? (period > 1 ? 8.0 / 48.0 : share / kProbeParts) : share);
+                       c.pruned && period <= 1 ? share * 2.0 / kProbeParts : share);
       if (c.pruned) {
         EXPECT_NE(r.choice.chosen.label, c.label);
         EXPECT_EQ(c.samples, 1);

@@ -334,12 +334,14 @@ RowBands other_bands(RowBands b) {
 }
 
 // A candidate's rows `b` (count 1) in kProbeParts parts, each one band in kProbeParts of its:
-// the probe first; empty when the probe would cover none of the film's `rows`.
+// the probe's two first; empty when they would cover none of the film's `rows`.
 std::vector<RowBands> probe_parts(const RowBands& b, int rows) {
   std::vector<RowBands> parts;
   for (int j = 0; j < kProbeParts; ++j)
     parts.push_back(RowBands{b.height, kProbeParts * b.period, b.first + j * b.period, 1});
-  if (b.count != 1 || covered_rows(parts[0].packed(), rows) == 0) parts.clear();
+  if (b.count != 1 || covered_rows(parts[0].packed(), rows) == 0 ||
+      covered_rows(parts[1].packed(), rows) == 0)
+    parts.clear();
   return parts;
 }
 
@@ -482,37 +484,40 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     Film film;
     double first_pass = 0.0; // seconds of the first pass
     if (!parts.empty()) {
+      // Part 0 loads its kernels (PoCL loads a kernel at its first launch), part 1 is timed.
       rs.bands = parts[0];
-      const auto start = Clock::now();
       film = renderer.render(rs);
-      first_pass = probe_cost * std::chrono::duration<double>(Clock::now() - start).count();
-      const double share = double(covered_rows(parts[0].packed(), fh)) / double(fh);
-      if (!may_beat_explored(cand, i, measure(films, emitter_scale), first_pass / share)) {
+      rs.bands = parts[1];
+      const auto start = Clock::now();
+      add_samples(film, renderer.render(rs));
+      const double probe = std::chrono::duration<double>(Clock::now() - start).count();
+      const double pass = probe * double(fh) / double(covered_rows(parts[1].packed(), fh));
+      if (!may_beat_explored(cand, i, measure(films, emitter_scale), probe_cost * pass)) {
         // Its probe is all it renders. The chosen candidate renders the probe's sample index on
         // the candidate's other rows, and the indices it would have rendered after.
         c.pruned = true;
-        c.pass_seconds = first_pass / share;
-        c.seconds = first_pass;
+        c.pass_seconds = pass;
+        c.seconds = probe;
         c.samples = 1;
-        c.explored_share = share;
-        for (size_t j = 1; j < parts.size(); ++j)
+        c.explored_share =
+            double(covered_rows(parts[0].packed(), fh) + covered_rows(parts[1].packed(), fh)) /
+            double(fh);
+        for (size_t j = 2; j < parts.size(); ++j)
           gaps.push_back({parts[j], c.first_sample, 1});
         if (interleaved)
           gaps.push_back({c.bands, c.first_sample + 1, 1});
         else if (!c.bands.all())
           gaps.push_back({other_bands(c.bands), c.first_sample, 1});
-        c.bands = parts[0];
         explored_end = std::max(explored_end, ++next);
         films.push_back(std::move(film));
         continue;
       }
-      for (size_t j = 1; j < parts.size(); ++j) { // the rest of its first pass
+      for (size_t j = 2; j < parts.size(); ++j) { // the rest of its first pass
         if (covered_rows(parts[j].packed(), fh) == 0) continue;
         rs.bands = parts[j];
-        const auto part = Clock::now();
         add_samples(film, renderer.render(rs));
-        first_pass += std::chrono::duration<double>(Clock::now() - part).count();
       }
+      first_pass = pass * c.explored_share;
     } else {
       rs.bands = c.bands;
       const auto start = Clock::now();

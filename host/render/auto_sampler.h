@@ -159,13 +159,14 @@ constexpr int kExploredPixels = 16384;
 RowBands exploration_bands(int width, int height, int period = 0);
 
 // The last candidate is the costly one (a splitting sampler's pass costs 4 to 18 times tree's on
-// the shipped scenes). It first renders its first pass on one in kProbeParts of its rows (the
-// probe), timed, and explores further only if it can still be the most efficient: its variance
-// is at least the emitter pixels' (ExploreStats::emitter_variance, the same for every candidate),
-// so 1 / (that x its time per pass) bounds its efficiency. Where the emitters' antialiasing is
-// most of the error (small, bright lights in view), a costly sample cannot pay, and the probe is
-// all it costs. The probe's samples stay in the image.
-constexpr int kProbeParts = 4;
+// the shipped scenes). It first renders its first pass on two in kProbeParts of its rows (the
+// probe: one that loads its kernels, one timed) and explores further only if it can still be the
+// most efficient: its variance is at least the emitter pixels' (ExploreStats::emitter_variance,
+// the same for every candidate), so 1 / (that x its time per pass) bounds its efficiency. If the
+// bound is below the best explored candidate's efficiency it is pruned. Where the emitters'
+// antialiasing is most of the error (small, bright lights in view), a costly sample cannot pay,
+// and the probe is all it costs. The probe's samples stay in the image.
+constexpr int kProbeParts = 8;
 // Whether a candidate whose pass takes `pass_seconds` may be more efficient than `best` (1 /
 // (variance x seconds per pass)), when its variance is at least `emitter_variance`.
 bool may_beat(double emitter_variance, double pass_seconds, double best_efficiency);
