@@ -401,6 +401,25 @@ bool may_beat_explored(const std::vector<PilotResult>& cand, size_t i, const Mea
   return best == 0.0 || may_beat(floor, pass_seconds, best);
 }
 
+// Whether the most efficient of the candidates before `i` (measured in `m`, with `m.film[i]`
+// candidate i's probe) that did not miss their tail is significantly more efficient than
+// candidate `i` at `pass_seconds` per pass (the paired tile comparison of choose_candidate).
+bool significantly_behind(const std::vector<PilotResult>& cand, size_t i, const Measured& m,
+                          double pass_seconds) {
+  std::vector<ExploreStats> before(m.film.begin(), m.film.begin() + std::ptrdiff_t(i));
+  const std::vector<bool> missed = missed_tails(before);
+  size_t best = i;
+  double e_best = 0.0;
+  for (size_t j = 0; j < i; ++j) {
+    const double e = m.film[j].variance > 0.0 && cand[j].pass_seconds > 0.0
+                         ? 1.0 / (m.film[j].variance * cand[j].pass_seconds)
+                         : 0.0;
+    if (!missed[j] && e > e_best) best = j, e_best = e;
+  }
+  return best < i &&
+         significantly_less(m.film[best], cand[best].pass_seconds, m.film[i], pass_seconds);
+}
+
 } // namespace
 
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
@@ -483,41 +502,71 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
         i + 1 == cand.size() && i > 0 ? probe_parts(c.bands, fh) : std::vector<RowBands>();
     Film film;
     double first_pass = 0.0; // seconds of the first pass
+    int rendered = 1;        // samples per pixel on its rows before the timed renders
     if (!parts.empty()) {
+      const int s0 = c.first_sample;
+      const double share1 = double(covered_rows(parts[1].packed(), fh)) / double(fh);
+      auto render_part = [&](size_t j, int first, int spp) { // its seconds
+        rs.bands = parts[j];
+        rs.first_sample = first;
+        rs.spp = spp;
+        const auto start = Clock::now();
+        add_samples(film, renderer.render(rs));
+        return std::chrono::duration<double>(Clock::now() - start).count();
+      };
       // Part 0 loads its kernels (PoCL loads a kernel at its first launch), part 1 is timed.
       rs.bands = parts[0];
       film = renderer.render(rs);
-      rs.bands = parts[1];
-      const auto start = Clock::now();
-      add_samples(film, renderer.render(rs));
-      const double probe = std::chrono::duration<double>(Clock::now() - start).count();
-      const double pass = probe * double(fh) / double(covered_rows(parts[1].packed(), fh));
-      if (!may_beat_explored(cand, i, measure(films, emitter_scale), probe_cost * pass)) {
-        // Its probe is all it renders. The chosen candidate renders the probe's sample index on
-        // the candidate's other rows, and the indices it would have rendered after.
+      const double probe = render_part(1, s0, 1);
+      double pass = probe / share1;
+      bool keep = may_beat_explored(cand, i, measure(films, emitter_scale), probe_cost * pass);
+      int probed = 1; // samples on part 1
+      if (keep && interleaved) {
+        // On interleaved rows it renders two samples in all: the second on part 1 first, which
+        // measures a variance there; significantly less efficient than the best, it is pruned.
+        pass = std::min(pass, render_part(1, s0 + 1, 1) / share1);
+        probed = 2;
+        std::vector<Film> with = films;
+        with.push_back(film);
+        keep = !significantly_behind(cand, i, measure(with, emitter_scale), probe_cost * pass);
+      }
+      if (!keep) {
+        // Its probe is all it renders. The chosen candidate renders the probe's sample indices
+        // on the candidate's other rows, and the indices it would have rendered after.
         c.pruned = true;
         c.pass_seconds = pass;
         c.seconds = probe;
-        c.samples = 1;
+        c.samples = probed;
         c.explored_share =
             double(covered_rows(parts[0].packed(), fh) + covered_rows(parts[1].packed(), fh)) /
             double(fh);
         for (size_t j = 2; j < parts.size(); ++j)
-          gaps.push_back({parts[j], c.first_sample, 1});
-        if (interleaved)
-          gaps.push_back({c.bands, c.first_sample + 1, 1});
-        else if (!c.bands.all())
-          gaps.push_back({other_bands(c.bands), c.first_sample, 1});
-        explored_end = std::max(explored_end, ++next);
+          gaps.push_back({parts[j], s0, interleaved ? 2 : 1});
+        if (interleaved) {
+          gaps.push_back({parts[0], s0 + 1, 1});
+          if (probed == 1) gaps.push_back({parts[1], s0 + 1, 1});
+        } else if (!c.bands.all()) {
+          gaps.push_back({other_bands(c.bands), s0, 1});
+        }
+        explored_end = std::max(explored_end, next + probed);
+        if (!interleaved) next += 1;
         films.push_back(std::move(film));
         continue;
       }
-      for (size_t j = 2; j < parts.size(); ++j) { // the rest of its first pass
-        if (covered_rows(parts[j].packed(), fh) == 0) continue;
-        rs.bands = parts[j];
-        add_samples(film, renderer.render(rs));
+      // The rest of its first pass, with a variance probe also of its second.
+      double rest = 0.0, rest_rows = 0.0;
+      for (size_t j = 2; j < parts.size(); ++j)
+        if (covered_rows(parts[j].packed(), fh) > 0) {
+          rest += render_part(j, s0, probed);
+          rest_rows += double(covered_rows(parts[j].packed(), fh));
+        }
+      if (probed == 2) {
+        render_part(0, s0 + 1, 1);
+        if (rest_rows > 0.0) pass = std::min(pass, rest / (2.0 * rest_rows / double(fh)));
       }
+      rendered = probed;
       first_pass = pass * c.explored_share;
+      c.pass_seconds = pass;
     } else {
       rs.bands = c.bands;
       const auto start = Clock::now();
@@ -525,9 +574,9 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       first_pass = std::chrono::duration<double>(Clock::now() - start).count();
     }
     rs.bands = c.bands;
-    next += 1;
+    next += rendered;
     rs.spp = passes[i];
-    for (int r = 0; r < renders; ++r) {
+    for (int r = 0; r < (rendered > 1 ? 0 : renders); ++r) {
       rs.first_sample = next;
       const auto start = Clock::now();
       Film f = renderer.render(rs);
