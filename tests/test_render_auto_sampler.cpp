@@ -33,10 +33,11 @@ struct AutoRun {
   explicit AutoRun(const std::string& json)
       : scene(load_scene_from_string(json, "scene.json", ".")),
         base(auto_candidates(RendererOptions{}).front().options), renderer(rt, scene, base) {}
-  AutoRender render(int spp, uint32_t seed) {
+  AutoRender render(int spp, uint32_t seed, size_t wave_size = RenderSettings{}.wave_size) {
     RenderSettings rs;
     rs.spp = spp;
     rs.seed = seed;
+    rs.wave_size = wave_size;
     return render_auto(renderer, base, rs);
   }
   Scene scene;
@@ -302,8 +303,10 @@ TEST(AutoSampler, TheExplorationRanksByEfficiencyAndItsSamplesArePartOfTheImage)
   AutoRun run(kGridJson);
   Renderer& renderer = run.renderer;
   RenderSettings rs;
-  rs.spp = 32;
-  AutoRender r = run.render(rs.spp, 7);
+  // Waves of one pass over the 64 x 48 film (a splitting candidate's: 16,384 paths, 6 passes): at
+  // 80 spp the film's exploration, 19 spp, is at most kFilmExplorationShare of them.
+  rs.spp = 80;
+  AutoRender r = run.render(rs.spp, 7, 64 * 48);
   const AutoChoice& choice = r.choice;
   ASSERT_EQ(choice.candidates.size(), 3u);
   int explored = 0;
@@ -338,11 +341,13 @@ TEST(AutoSampler, TheExplorationRanksByEfficiencyAndItsSamplesArePartOfTheImage)
 // unbiased: over 8 seeds its image mean equals the exhaustive estimator's within 5 standard errors
 // of the difference; under point lights alone, and with sphere lights in view (whose pixels weigh
 // every sample 1), with the exploration on every row, on bands of them (one in three) for the
-// splitting candidate, and (at 5 spp, below kFilmExplorationMinSpp) on interleaved rows, a third
-// of them each; and with the last candidate's probe timed as if it were 10^4 times costlier: with
-// emitters in view it is pruned after its probe (its variance is at least theirs), under point
-// lights alone only where its probe also measures its variance (on interleaved rows), else it may
-// still win and explores. (Otherwise the probe counts as free: tests do not time.)
+// splitting candidate, and on interleaved rows, a third of them each (at 5 spp, below
+// kFilmExplorationMinSpp, two samples each; at 48 spp with full waves, where the film's
+// exploration would cost too much, three); and with the last candidate's probe timed as if it were
+// 10^4 times costlier: with emitters in view it is pruned after its probe (its variance is at least
+// theirs), under point lights alone only where its probe also measures its variance (on interleaved
+// rows), else it may still win and explores. (Otherwise the probe counts as free: tests do not
+// time.)
 class CombinedImage : public ::testing::TestWithParam<std::tuple<bool, int, bool>> {};
 
 TEST_P(CombinedImage, IsUnbiased) {
@@ -383,17 +388,22 @@ TEST_P(CombinedImage, IsUnbiased) {
   RendererOptions base = auto_candidates(RendererOptions{}).front().options;
   // Waves of 256 paths for the splitting candidate: a pass over its bands (16 of 48 rows) fills
   // one, so it explores on them; power and tree, whose waves hold 2^18 paths, on the film.
-  if (period > 1) base.split_queue_items = 1 << 14;
-  const bool interleaved = period == 0;
+  // Waves of one pass on the film (and of 256 paths for the splitting candidate, 1 << 14 items
+  // over its cut of 64): at 48 spp the film's exploration, 9 spp, is at most
+  // kFilmExplorationShare of them.
+  if (period > 0) base.split_queue_items = 1 << 14;
+  const bool interleaved = period <= 0;
   Renderer renderer(rt, scene, base);
   std::vector<double> means;
   for (uint32_t seed = 1; seed <= 8; ++seed) {
-    rs.spp = interleaved ? 5 : kFilmExplorationMinSpp;
+    rs.spp = period == 0 ? 5 : 48;
+    // at 48 spp with waves of 2^18 paths the film's exploration would cost most of the samples
+    rs.wave_size = period < 0 ? RenderSettings{}.wave_size : 64 * 48;
     rs.seed = seed;
     AutoRender r = render_auto(renderer, base, rs, period, costly ? 1e4 : 0.0);
     ASSERT_FALSE(r.choice.candidates.empty());
-    if (interleaved) {
-      EXPECT_EQ(r.choice.explored_samples, 2);
+    if (interleaved) { // max(2, spp / 16) each
+      EXPECT_EQ(r.choice.explored_samples, period == 0 ? 2 : 3);
     }
     // On interleaved rows the probe also measures a variance, and 10^4 times the cost is
     // significantly behind.
@@ -426,7 +436,7 @@ TEST_P(CombinedImage, IsUnbiased) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AutoSampler, CombinedImage,
-                         ::testing::Combine(::testing::Bool(), ::testing::Values(1, 3, 0),
+                         ::testing::Combine(::testing::Bool(), ::testing::Values(1, 3, 0, -1),
                                             ::testing::Bool()),
                          [](const auto& p) {
                            const int mode = std::get<1>(p.param);
@@ -434,7 +444,8 @@ INSTANTIATE_TEST_SUITE_P(AutoSampler, CombinedImage,
                                                                    : "PointLights") +
                                   (mode == 1   ? ""
                                    : mode == 3 ? "OnBands"
-                                               : "OnInterleavedRows") +
+                                   : mode == 0 ? "OnInterleavedRows"
+                                               : "OnInterleavedRowsAt48Spp") +
                                   (std::get<2>(p.param) ? "CostlyLast" : "");
                          });
 
@@ -505,7 +516,8 @@ TEST(AutoSampler, ACandidateOnBandsIsComparedOverItsRows) {
   Renderer renderer(rt, scene, base);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
     RenderSettings rs;
-    rs.spp = kFilmExplorationMinSpp;
+    rs.spp = 48; // waves of one pass: the film's exploration is 9 spp
+    rs.wave_size = 128 * 128;
     rs.seed = seed;
     AutoRender r = render_auto(renderer, base, rs, 4, 0.0); // a free probe: it explores
     ASSERT_EQ(r.choice.candidates.size(), 3u);
@@ -553,9 +565,10 @@ TEST(AutoSampler, ABlackScenePicksTheFastest) {
 }
 
 // One dim light close over the floor outshines 65,536 distant ones there, but holds 6e-9 of the
-// power: power sampling picks it about never in an exploration of ~10^4 samples, so its image
+// power: power sampling picks it about never in an exploration of 10^3-10^4 samples, so its image
 // mean falls far below the others' and its measured variance means nothing. It is not ranked, and
-// its samples weigh nothing.
+// its samples weigh nothing: on interleaved rows (32 spp, 2 samples each on a third of the rows)
+// and on the film (80 spp, waves of one pass).
 TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRankedNorWeighted) {
   const char* json = R"({
     "camera": { "position": [0, 3, 3], "look_at": [0, 0, 0], "fov": 50 },
@@ -568,13 +581,16 @@ TEST(AutoSampler, ACandidateThatMissesItsTailIsNotRankedNorWeighted) {
                       "light": { "type": "point", "intensity": 100 } } ]
   })";
   AutoRun run(json);
-  AutoChoice choice = run.render(32, 11).choice;
-  EXPECT_TRUE(choice.candidates[0].missed_tail) << describe(choice);
-  EXPECT_FALSE(choice.candidates[1].missed_tail) << describe(choice);
-  EXPECT_NE(choice.chosen.label, "power");
-  EXPECT_NE(describe(choice).find("missed its tail"), std::string::npos);
-  EXPECT_EQ(choice.candidates[0].weight[0], 0.0);
-  EXPECT_EQ(choice.candidates[0].weight[1], 0.0);
+  for (int spp : {32, 80}) {
+    AutoChoice choice =
+        run.render(spp, 11, spp == 80 ? 64 * 48 : RenderSettings{}.wave_size).choice;
+    EXPECT_TRUE(choice.candidates[0].missed_tail) << spp << " spp: " << describe(choice);
+    EXPECT_FALSE(choice.candidates[1].missed_tail) << spp << " spp: " << describe(choice);
+    EXPECT_NE(choice.chosen.label, "power");
+    EXPECT_NE(describe(choice).find("missed its tail"), std::string::npos);
+    EXPECT_EQ(choice.candidates[0].weight[0], 0.0);
+    EXPECT_EQ(choice.candidates[0].weight[1], 0.0);
+  }
 }
 
 // The exploration switches samplers on one renderer, and a tree sampler after another keeps the

@@ -118,16 +118,16 @@ constexpr size_t kFewSamplesCandidate = 1; // tree
 // explore (spp <= 2 x candidates: then the last candidate renders everything).
 std::vector<int> plan_exploration(int spp, const std::vector<int>& wave_passes, int* renders);
 
-// Marks the candidates that missed their tail (mean more than 4 standard errors below the median
-// candidate's), then returns the chosen one's index: the most efficient of the rest, unless a
-// candidate that it does not beat significantly has at most half its tail share (the lighter tail
-// is taken: a heavy tail's variance from a few samples is unreliable); then, the cheapest
-// candidate of at most kCheaperFactor times its time per pass that it does not beat significantly
-// and whose tail is no heavier: its render of the user's spp ends much sooner at no significant
-// loss. "Significantly": the difference of variance x seconds per pass, summed over tiles,
-// exceeds 1.96 standard errors of that sum estimated from the tiles' differences (a paired
-// comparison: the spread between tiles that every candidate shares cancels). Without a measured
-// variance (a black image), the fastest. Pruned candidates take no part. Sets `reason`.
+// Marks the candidates that missed their tail (mean more than 4 standard errors below the
+// others', weighted by inverse variance), then returns the chosen one's index: the most efficient
+// of the rest, unless a candidate that it does not beat significantly has at most half its tail
+// share (the lighter tail is taken: a heavy tail's variance from a few samples is unreliable);
+// then, the cheapest candidate of at most kCheaperFactor times its time per pass that it does not
+// beat significantly and whose tail is no heavier: its render of the user's spp ends much sooner
+// at no significant loss. "Significantly": the difference of variance x seconds per pass, summed
+// over tiles, exceeds 1.96 standard errors of that sum estimated from the tiles' differences (a
+// paired comparison: the spread between tiles that every candidate shares cancels). Without a
+// measured variance (a black image), the fastest. Pruned candidates take no part. Sets `reason`.
 size_t choose_candidate(std::vector<PilotResult>& candidates, std::string* reason);
 constexpr double kCheaperFactor = 0.5;
 
@@ -149,11 +149,15 @@ std::vector<double> exploration_weights(std::vector<PilotResult> other);
 // 1 to 4 that keeps that many pixels and a band in every tile of the film's 8 x 8.
 constexpr int kExploreBandRows = 8;
 // From kFilmExplorationMinSpp samples per pixel the candidates explore the film (or its bands,
-// plan_exploration). Below, down to kInterleavedMinSpp, each candidate renders two samples on its
-// own interleaved rows (every third row: the rows of all candidates show the same image) and the
-// chosen one the rest: the exploration then costs about 2 spp of the render, where on the film it
-// costs at least 6 spp of each candidate (more than half of a 1 s preview's samples).
+// plan_exploration), where that costs at most kFilmExplorationShare of the samples. Else, down to
+// kInterleavedMinSpp, each candidate renders k samples on its own interleaved rows (every third
+// row: the rows of all candidates show the same image), k = max(2, spp /
+// kInterleavedSamplesDivisor), and the chosen one the rest: the exploration then costs about k spp
+// of the render, where on the film it costs at least 6 spp of each candidate, and the film's full
+// waves 17 of 32 spp on a 256 x 256 film.
 constexpr int kFilmExplorationMinSpp = 32;
+constexpr double kFilmExplorationShare = 0.25;
+constexpr int kInterleavedSamplesDivisor = 16;
 constexpr int kInterleavedMinSpp = 3;
 constexpr int kExploredPixels = 16384;
 RowBands exploration_bands(int width, int height, int period = 0);
@@ -175,7 +179,8 @@ bool may_beat(double emitter_variance, double pass_seconds, double best_efficien
 // candidate after exploring all, some on bands of rows (exploration_bands(film, explore_period);
 // see the file comment); the film's sums are weighted so that its mean is the
 // unbiased image and its count per pixel is spp. Leaves `renderer` set to the chosen candidate.
-// Below kFilmExplorationMinSpp spp, down to kInterleavedMinSpp, the candidates explore on
+// Where the film's exploration would cost more than kFilmExplorationShare of the samples (always
+// below kFilmExplorationMinSpp spp), down to kInterleavedMinSpp, the candidates explore on
 // interleaved rows; below that kFewSamplesCandidate renders it all, and
 // in a window the last candidate. `probe_cost` multiplies the probe's measured time (tests: a
 // candidate as if that many times costlier).
