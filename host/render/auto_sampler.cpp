@@ -393,26 +393,9 @@ Measured measure(const std::vector<Film>& films, double emitter_scale) {
   return m;
 }
 
-// Whether candidate `i`, at `pass_seconds` per pass, may be more efficient than the most efficient
-// of the candidates before it (measured `m`) that did not miss their tail.
-bool may_beat_explored(const std::vector<PilotResult>& cand, size_t i, const Measured& m,
-                       double pass_seconds) {
-  const std::vector<bool> missed = missed_tails(m.film);
-  double best = 0.0, floor = 0.0;
-  for (size_t j = 0; j < std::min(i, m.film.size()); ++j) {
-    const double e = m.film[j].variance > 0.0 && cand[j].pass_seconds > 0.0
-                         ? 1.0 / (m.film[j].variance * cand[j].pass_seconds)
-                         : 0.0;
-    if (!missed[j] && e > best) best = e, floor = m.film[j].emitter_variance;
-  }
-  return best == 0.0 || may_beat(floor, pass_seconds, best);
-}
-
-// Whether the most efficient of the candidates before `i` (measured in `m`, with `m.film[i]`
-// candidate i's probe) that did not miss their tail is significantly more efficient than
-// candidate `i` at `pass_seconds` per pass (the paired tile comparison of choose_candidate).
-bool significantly_behind(const std::vector<PilotResult>& cand, size_t i, const Measured& m,
-                          double pass_seconds) {
+// The most efficient of the candidates before `i` (measured in `m`) that did not miss their
+// tail; `i` if none.
+size_t best_explored(const std::vector<PilotResult>& cand, size_t i, const Measured& m) {
   std::vector<ExploreStats> before(m.film.begin(), m.film.begin() + std::ptrdiff_t(i));
   const std::vector<bool> missed = missed_tails(before);
   size_t best = i;
@@ -423,8 +406,28 @@ bool significantly_behind(const std::vector<PilotResult>& cand, size_t i, const 
                          : 0.0;
     if (!missed[j] && e > e_best) best = j, e_best = e;
   }
-  return best < i &&
-         significantly_less(m.film[best], cand[best].pass_seconds, m.film[i], pass_seconds);
+  return best;
+}
+
+// Whether candidate `i`, at `pass_seconds` per pass, may be more efficient than the most efficient
+// of the candidates before it (measured `m`) that did not miss their tail.
+bool may_beat_explored(const std::vector<PilotResult>& cand, size_t i, const Measured& m,
+                       double pass_seconds) {
+  const size_t b = best_explored(cand, i, m);
+  return b == i || may_beat(m.film[b].emitter_variance, pass_seconds,
+                            1.0 / (m.film[b].variance * cand[b].pass_seconds));
+}
+
+// Candidate `i` (its probe measured in `m.film[i]`, at `pass_seconds` per pass) against the best
+// before it: -1 if that is significantly more efficient, 1 if `i` is, else 0 (the paired tile
+// comparison of choose_candidate).
+int against_best(const std::vector<PilotResult>& cand, size_t i, const Measured& m,
+                 double pass_seconds) {
+  const size_t b = best_explored(cand, i, m);
+  if (b == i) return 0;
+  if (significantly_less(m.film[b], cand[b].pass_seconds, m.film[i], pass_seconds)) return -1;
+  if (significantly_less(m.film[i], pass_seconds, m.film[b], cand[b].pass_seconds)) return 1;
+  return 0;
 }
 
 } // namespace
@@ -531,16 +534,31 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       film = renderer.render(rs);
       const double probe = render_part(1, s0, 1);
       double pass = probe / share1;
-      bool keep = may_beat_explored(cand, i, measure(films, emitter_scale), probe_cost * pass);
+      const Measured before = measure(films, emitter_scale);
+      bool keep = may_beat_explored(cand, i, before, probe_cost * pass);
+      // The rest of its exploration, in passes over the film, against kCostlyExplorationShare of
+      // the render that the best so far would make of the user's samples.
+      const double share0 = double(covered_rows(parts[0].packed(), fh)) / double(fh);
+      const double rest = interleaved
+                              ? double(k) * c.explored_share - share0 - 2.0 * share1
+                              : c.explored_share * (1.0 + renders * passes[i]) - share0 - share1;
+      const size_t b = best_explored(cand, i, before);
+      const bool costly =
+          b < i && probe_cost * pass * rest >
+                       kCostlyExplorationShare * double(settings.spp) * cand[b].pass_seconds;
       int probed = 1; // samples on part 1
       if (keep && interleaved) {
         // On interleaved rows it renders k >= 2 samples in all: the second on part 1 first, which
-        // measures a variance there; significantly less efficient than the best, it is pruned.
+        // measures a variance there. Significantly less efficient than the best, it is pruned; if
+        // the rest of its exploration is costly, unless it is significantly more efficient.
         pass = std::min(pass, render_part(1, s0 + 1, 1) / share1);
         probed = 2;
         std::vector<Film> with = films;
         with.push_back(film);
-        keep = !significantly_behind(cand, i, measure(with, emitter_scale), probe_cost * pass);
+        const int verdict = against_best(cand, i, measure(with, emitter_scale), probe_cost * pass);
+        keep = costly ? verdict > 0 : verdict >= 0;
+      } else if (keep) {
+        keep = !costly; // one sample per pixel: no variance to weigh against the cost
       }
       if (!keep) {
         // Its probe is all it renders. The chosen candidate renders the probe's sample indices
@@ -566,15 +584,15 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
         continue;
       }
       // The rest of its first pass, with a variance probe also of its second.
-      double rest = 0.0, rest_rows = 0.0;
+      double rest_seconds = 0.0, rest_rows = 0.0;
       for (size_t j = 2; j < parts.size(); ++j)
         if (covered_rows(parts[j].packed(), fh) > 0) {
-          rest += render_part(j, s0, probed);
+          rest_seconds += render_part(j, s0, probed);
           rest_rows += double(covered_rows(parts[j].packed(), fh));
         }
       if (probed == 2) {
         render_part(0, s0 + 1, 1);
-        if (rest_rows > 0.0) pass = std::min(pass, rest / (2.0 * rest_rows / double(fh)));
+        if (rest_rows > 0.0) pass = std::min(pass, rest_seconds / (2.0 * rest_rows / double(fh)));
       }
       rendered = probed;
       first_pass = pass * c.explored_share;
@@ -691,7 +709,7 @@ std::string describe(const AutoChoice& choice) {
         i ? "," : "", c.label, c.efficiency, c.efficiency_lo, c.efficiency_hi, c.pass_seconds,
         100.0 * c.explored_share, c.stats.tail_share, c.weight[0], c.weight[1],
         c.missed_tail ? " (missed its tail: not ranked)"
-        : c.pruned    ? " (its probe: it could not be the most efficient)"
+        : c.pruned    ? " (pruned after its probe)"
                       : "");
   }
   return s + ")";

@@ -171,6 +171,13 @@ RowBands exploration_bands(int width, int height, int period = 0);
 // antialiasing is most of the error (small, bright lights in view), a costly sample cannot pay,
 // and the probe is all it costs. The probe's samples stay in the image.
 constexpr int kProbeParts = 8;
+// Where the rest of its exploration would cost more than this share of the render that the best
+// candidate so far would make of the user's samples, the costly candidate explores no further
+// unless its probe shows it significantly more efficient (on interleaved rows, where the probe
+// measures a variance), and on the film not at all: its exploration would otherwise be most of a
+// short render (on the showroom two samples on a third of the rows cost 0.6 s, as much as a
+// 16-spp render with `power`).
+constexpr double kCostlyExplorationShare = 0.25;
 // Whether a candidate whose pass takes `pass_seconds` may be more efficient than `best` (1 /
 // (variance x seconds per pass)), when its variance is at least `emitter_variance`.
 bool may_beat(double emitter_variance, double pass_seconds, double best_efficiency);
