@@ -409,15 +409,6 @@ size_t best_explored(const std::vector<PilotResult>& cand, size_t i, const Measu
   return best;
 }
 
-// Whether candidate `i`, at `pass_seconds` per pass, may be more efficient than the most efficient
-// of the candidates before it (measured `m`) that did not miss their tail.
-bool may_beat_explored(const std::vector<PilotResult>& cand, size_t i, const Measured& m,
-                       double pass_seconds) {
-  const size_t b = best_explored(cand, i, m);
-  return b == i || may_beat(m.film[b].emitter_variance, pass_seconds,
-                            1.0 / (m.film[b].variance * cand[b].pass_seconds));
-}
-
 // Candidate `i` (its probe measured in `m.film[i]`, at `pass_seconds` per pass) against the best
 // before it: -1 if that is significantly more efficient, 1 if `i` is, else 0 (the paired tile
 // comparison of choose_candidate).
@@ -535,15 +526,18 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       film = renderer.render(rs);
       const double probe = render_part(1, s0, 1);
       double pass = probe / share1;
+      // Against the most efficient candidate so far: its variance bounds this one's from below
+      // where emitters are in view (may_beat), and the rest of this one's exploration, in passes
+      // over the film, is weighed against kCostlyExplorationShare of the render that the best
+      // would make of the user's samples.
       const Measured before = measure(films, emitter_scale);
-      bool keep = may_beat_explored(cand, i, before, probe_cost * pass);
-      // The rest of its exploration, in passes over the film, against kCostlyExplorationShare of
-      // the render that the best so far would make of the user's samples.
+      const size_t b = best_explored(cand, i, before);
+      bool keep = b == i || may_beat(before.film[b].emitter_variance, probe_cost * pass,
+                                     1.0 / (before.film[b].variance * cand[b].pass_seconds));
       const double share0 = double(covered_rows(parts[0].packed(), fh)) / double(fh);
       const double rest = interleaved
                               ? double(k) * c.explored_share - share0 - 2.0 * share1
                               : c.explored_share * (1.0 + renders * passes[i]) - share0 - share1;
-      const size_t b = best_explored(cand, i, before);
       const bool costly =
           b < i && probe_cost * pass * rest >
                        kCostlyExplorationShare * double(settings.spp) * cand[b].pass_seconds;
@@ -568,9 +562,7 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
         c.pass_seconds = pass;
         c.seconds = probe;
         c.samples = probed;
-        c.explored_share =
-            double(covered_rows(parts[0].packed(), fh) + covered_rows(parts[1].packed(), fh)) /
-            double(fh);
+        c.explored_share = share0 + share1;
         for (size_t j = 2; j < parts.size(); ++j)
           gaps.push_back({parts[j], s0, interleaved ? k : 1});
         if (interleaved) {
