@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <optional>
+#include <sched.h>
 #include <sstream>
 #include <unistd.h>
 
@@ -114,6 +115,21 @@ static void configure_pocl() {
   // once cached). Generic work-group functions are compiled once per kernel. A value the user set
   // is kept.
   setenv("POCL_WORK_GROUP_SPECIALIZATION", "0", 0);
+  // PoCL's worker threads, one per core, are pinned to their cores (POCL_AFFINITY: worker i to
+  // CPU i). Unpinned, the scheduler keeps them on one core for the process's first 0.2-0.5 s of
+  // kernels (a render of 1 sample on a third of default.json's rows took 23-56 ms there, 19-25 ms
+  // after, and a contended atomic kernel ran faster: one thread did the work), so the estimator
+  // choice timed the candidate it explored first up to 2x too slow. Only where the process may
+  // run on every online CPU, so that CPU i exists for it; a value the user set is kept.
+  cpu_set_t allowed;
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  if (online > 0 && sched_getaffinity(0, sizeof(allowed), &allowed) == 0 &&
+      CPU_COUNT(&allowed) == online) {
+    bool first_cpus = true;
+    for (long i = 0; i < online && i < CPU_SETSIZE; ++i)
+      first_cpus = first_cpus && CPU_ISSET(int(i), &allowed);
+    if (first_cpus) setenv("POCL_AFFINITY", "1", 0);
+  }
 }
 
 std::vector<DeviceInfo> list_devices() {

@@ -50,6 +50,26 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr int kTiles = 8; // per film side: 64 tiles, 32 in each half
 
+// A render of `rs` and its device seconds: the summed profiled times of its kernels. The
+// exploration times its candidates by these, not by the wall clock: its renders are small (one
+// sample on a third of the rows at a 1 s budget, 10-25 ms), and a render's fixed host cost
+// (binding, fills, read-backs: about 5 ms) and the machine's jitter were a third to half of that
+// wall time, which drew the candidates' costs together (cornell-1k's direct light: `tree` timed
+// at 1.05x `power` per pass, 1.56x in the render). In a render of the user's samples the kernels
+// are 95-97% of the wall time for every candidate, splitting ones included (docs/design.md).
+Film timed_render(Renderer& renderer, const RenderSettings& rs, double* seconds) {
+  auto device_seconds = [&renderer] {
+    double s = 0.0;
+    for (const auto& [stage, st] : renderer.stats().stages)
+      s += st.seconds;
+    return s;
+  };
+  const double before = device_seconds();
+  Film film = renderer.render(rs);
+  *seconds = device_seconds() - before;
+  return film;
+}
+
 bool same_sampler(const RendererOptions& a, const RendererOptions& b) {
   return a.light_sampler == b.light_sampler && a.split_threshold == b.split_threshold &&
          a.max_cut == b.max_cut && a.orientation_term == b.orientation_term && a.mis == b.mis;
@@ -508,18 +528,18 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     const std::vector<RowBands> parts =
         i + 1 == cand.size() && i > 0 ? probe_parts(c.bands, fh) : std::vector<RowBands>();
     Film film;
-    double first_pass = 0.0; // seconds of the first pass
+    double first_pass = 0.0; // device seconds of the first pass
     int rendered = 1;        // samples per pixel on its rows before the timed renders
     if (!parts.empty()) {
       const int s0 = c.first_sample;
       const double share1 = double(covered_rows(parts[1].packed(), fh)) / double(fh);
-      auto render_part = [&](size_t j, int first, int spp) { // its seconds
+      auto render_part = [&](size_t j, int first, int spp) { // its device seconds
         rs.bands = parts[j];
         rs.first_sample = first;
         rs.spp = spp;
-        const auto start = Clock::now();
-        add_samples(film, renderer.render(rs));
-        return std::chrono::duration<double>(Clock::now() - start).count();
+        double t = 0.0;
+        add_samples(film, timed_render(renderer, rs, &t));
+        return t;
       };
       // Part 0 loads its kernels (PoCL loads a kernel at its first launch), part 1 is timed.
       rs.bands = parts[0];
@@ -592,18 +612,15 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       c.pass_seconds = pass;
     } else {
       rs.bands = c.bands;
-      const auto start = Clock::now();
-      film = renderer.render(rs);
-      first_pass = std::chrono::duration<double>(Clock::now() - start).count();
+      film = timed_render(renderer, rs, &first_pass);
     }
     rs.bands = c.bands;
     next += rendered;
     rs.spp = passes[i] - (rendered - 1); // the passes a probe left
     for (int r = 0; r < (rs.spp > 0 ? renders : 0); ++r) {
       rs.first_sample = next;
-      const auto start = Clock::now();
-      Film f = renderer.render(rs);
-      const double t = std::chrono::duration<double>(Clock::now() - start).count();
+      double t = 0.0;
+      const Film f = timed_render(renderer, rs, &t);
       const double per_pass = t / rs.spp / c.explored_share; // a pass over the whole film
       c.pass_seconds = r == 0 && rendered == 1 ? per_pass : std::min(c.pass_seconds, per_pass);
       c.seconds += t;

@@ -74,8 +74,8 @@ struct PilotResult {
   RowBands bands;                    // on these rows (exploration_bands), or all
   double explored_share = 1.0;       // of the film's pixels
   ExploreStats stats;                // over the film
-  double seconds = 0.0;              // of its timed exploration renders
-  double pass_seconds = 0.0;         // a sample pass over the film, timed in the exploration
+  double seconds = 0.0;              // of its timed exploration renders, on the device
+  double pass_seconds = 0.0;         // a sample pass over the film, device seconds (exploration)
   // 1 / (variance x pass_seconds), 0 if the variance is 0, and its interval from the variance's
   double efficiency = 0.0, efficiency_lo = 0.0, efficiency_hi = 0.0;
   // Its image mean is far below the others': it missed rare large samples, so its measured
