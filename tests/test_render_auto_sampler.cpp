@@ -149,6 +149,35 @@ TEST(AutoSampler, ExplorationWeightsAreInverseVarianceToTheChoiceAndDropAMissedT
   EXPECT_EQ(w[2], 1.0);
 }
 
+// Measured on different rows, two candidates' means differ by what their rows show as well. A
+// mean 5 standard errors of the samples below the other's is a missed tail where each candidate's
+// own rows agree between every other row and the rows between; where they differ that much (the
+// image changes from row to row), it is the rows' structure, and the candidate stays ranked. On
+// common pixels the rows' structure takes no part.
+TEST(AutoSampler, TheMissedTailTestAllowsForTheStructureOfTheRows) {
+  auto missed = [](double split, bool own_rows) {
+    std::vector<PilotResult> c(2);
+    for (size_t i = 0; i < c.size(); ++i) {
+      c[i].label = i == 0 ? "low" : "high";
+      c[i].stats.variance = i == 0 ? 1.0 : 2.0;
+      c[i].stats.tile_variance.assign(32, c[i].stats.variance / 32);
+      c[i].stats.mean = i == 0 ? 0.95 : 1.0;
+      c[i].stats.mean_variance = 0.5 * 1e-4; // the difference's standard error: 0.01
+      c[i].stats.row_split = split;
+      c[i].stats.row_split_variance = 2e-4;
+      c[i].stats.own_rows = own_rows;
+      c[i].pass_seconds = 1.0;
+    }
+    std::string reason;
+    choose_candidate(c, &reason);
+    return c[0].missed_tail;
+  };
+  EXPECT_TRUE(missed(0.0, true));   // rows that agree: 5 standard errors below
+  EXPECT_TRUE(missed(0.014, true)); // the samples' own spread between every other row
+  EXPECT_FALSE(missed(0.1, true));  // rows 10% apart: a 5% difference is theirs
+  EXPECT_TRUE(missed(0.1, false));  // the same pixels: no structure between them
+}
+
 // The most efficient is chosen. A leader whose lead over another is not significant tile by tile
 // (its variance is mostly one tile's) gives way to that one's lighter tail, or to a cheaper one
 // whose tail is no heavier; a leader that is better in every tile stays, whatever its tail.

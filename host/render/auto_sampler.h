@@ -33,6 +33,12 @@ struct ExploreStats {
   // Over the pixels whose camera rays saw no emitter: the image's mean value and that mean's
   // variance (the missed-tail test).
   double mean = 0.0, mean_variance = 0.0;
+  // The same mean over every other row with samples minus the mean over the rows between, and
+  // that difference's variance from the samples: what the image's own structure from row to row
+  // adds to the difference of two candidates' means where they were measured on different rows
+  // (interleaved rows, `own_rows`), for the missed-tail test.
+  double row_split = 0.0, row_split_variance = 0.0;
+  bool own_rows = false;
   // Per tile of the film (8 x 8): the sum of its pixels' variances, divided by the pixel count
   // (so they add up to `variance`); NaN for a tile without measured pixels (of the other half, or
   // off the candidate's bands of rows). Candidates are compared tile by tile: a tile's variance
