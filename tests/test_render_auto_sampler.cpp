@@ -253,20 +253,68 @@ TEST(AutoSampler, TheEmitterPixelsVarianceIsPooledOverTheCandidates) {
   const std::vector<Film> films = {film(1000.0), film(3.0)};
   std::vector<uint8_t> in_view(16 * 16, 0);
   in_view[37] = 1;
-  const std::vector<double> pooled = pooled_emitter_variance(films, in_view);
-  ASSERT_EQ(pooled.size(), 64u);
+  const EmitterPool pool = pool_emitters(films, in_view);
+  ASSERT_EQ(pool.variance.size(), 64u);
   const int tile = (37 / 16 * 8 / 16) * 8 + (37 % 16) * 8 / 16; // the tile of pixel (5, 2)
   const double va = 999.0 * 999.0 / 2.0, vb = 2.0 * 2.0 / 2.0;
-  EXPECT_DOUBLE_EQ(pooled[size_t(tile)], 0.5 * (va + vb));
-  EXPECT_TRUE(std::isnan(pooled[0]));
+  EXPECT_DOUBLE_EQ(pool.variance[size_t(tile)], 0.5 * (va + vb));
+  EXPECT_DOUBLE_EQ(pool.share[size_t(tile)], 0.25); // one of the tile's 2 x 2 pixels
+  EXPECT_DOUBLE_EQ(pool.pixels[size_t(tile)], 4.0);
+  EXPECT_TRUE(std::isnan(pool.variance[0]));
   const std::vector<uint8_t> off_mean = in_view;
-  const ExploreStats a = explore_stats(films[0], off_mean, -1, &in_view, &pooled);
-  const ExploreStats b = explore_stats(films[1], off_mean, -1, &in_view, &pooled);
+  const ExploreStats a = explore_stats(films[0], off_mean, -1, &in_view, &pool);
+  const ExploreStats b = explore_stats(films[1], off_mean, -1, &in_view, &pool);
   EXPECT_DOUBLE_EQ(a.variance, b.variance);
   EXPECT_DOUBLE_EQ(a.variance, (255 * 0.5 + 0.5 * (va + vb)) / 256.0);
   EXPECT_DOUBLE_EQ(a.emitter_variance, 0.5 * (va + vb) / 256.0);
   EXPECT_GT(explore_stats(films[0], off_mean, -1).variance,
             100.0 * explore_stats(films[1], off_mean, -1).variance);
+}
+
+// Candidates on interleaved rows see a small emitter in view on unequal numbers of their rows. Two
+// films alike (variance 0.5 per pixel) but one on the even rows and one on the odd rows of a 32 x
+// 32 film (tiles of 4 x 4 pixels), with pixels in view (variance 400) on rows 0-2: two of the even
+// film's rows, one of the odd one's. Each counts the pool's share of them per tile (3/4 in the
+// first row of tiles), so both measure the same variance and emitter part, which their own pixels
+// would not give.
+TEST(AutoSampler, EveryCandidateCountsTheEmittersInViewAlike) {
+  const int size = 32;
+  auto film = [&](int parity) {
+    Film f;
+    f.width = f.film_width = f.height = f.film_height = size;
+    const size_t n = size_t(size * size);
+    f.sum.assign(n, double4{});
+    f.sumsq.assign(n, double4{});
+    f.counts.assign(n, double4{});
+    for (size_t p = 0; p < n; ++p) {
+      if (int(p) / size % 2 != parity) continue;
+      const bool in_view = p / size_t(size) < 3;
+      const double a2 = in_view ? 200.0 : 0.25; // two samples 1 +- a: variance 2 a^2
+      f.sum[p] = double4{2.0, 2.0, 2.0, 2.0};
+      f.sumsq[p] = double4{2.0 + 2.0 * a2, 2.0 + 2.0 * a2, 2.0 + 2.0 * a2, 2.0};
+      f.counts[p].z = in_view ? 2.0 : 0.0;
+    }
+    return f;
+  };
+  const std::vector<Film> films = {film(0), film(1)};
+  std::vector<uint8_t> in_view(size_t(size * size), 0);
+  for (size_t p = 0; p < 3 * size_t(size); ++p)
+    in_view[p] = 1;
+  const EmitterPool pool = pool_emitters(films, in_view);
+  EXPECT_DOUBLE_EQ(pool.variance[0], 400.0);
+  EXPECT_DOUBLE_EQ(pool.share[0], 0.75);
+  EXPECT_DOUBLE_EQ(pool.pixels[0], 16.0);
+  const ExploreStats even = explore_stats(films[0], in_view, -1, &in_view, &pool);
+  const ExploreStats odd = explore_stats(films[1], in_view, -1, &in_view, &pool);
+  const double first_row = 0.75 * 400.0 + 0.25 * 0.5; // of tiles
+  const double expected = (first_row + 7.0 * 0.5) / 8.0;
+  EXPECT_NEAR(even.variance, expected, 1e-9 * expected);
+  EXPECT_NEAR(odd.variance, expected, 1e-9 * expected);
+  EXPECT_NEAR(even.emitter_variance, 0.75 * 400.0 / 8.0, 1e-9);
+  EXPECT_NEAR(odd.emitter_variance, 0.75 * 400.0 / 8.0, 1e-9);
+  // Each film's own pixels: 2 of the even film's 16 rows are in view, 1 of the odd film's.
+  EXPECT_GT(explore_stats(films[0], in_view, -1).variance,
+            1.5 * explore_stats(films[1], in_view, -1).variance);
 }
 
 // The emitters' antialiasing error at N samples per pixel, against what their per-sample variance

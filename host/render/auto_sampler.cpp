@@ -116,19 +116,31 @@ double pixel_variance(const Film& film, size_t p) {
 
 } // namespace
 
-std::vector<double> pooled_emitter_variance(const std::vector<Film>& films,
-                                            const std::vector<uint8_t>& emitter) {
-  std::vector<double> sum(kTiles * kTiles, 0.0), n(kTiles * kTiles, 0.0);
-  for (const Film& f : films)
-    for (size_t p = 0; p < f.sum.size(); ++p)
-      if (emitter[p] && f.sum[p].w > 1.0) {
-        const int t = tile_of(f, p);
-        sum[size_t(t)] += pixel_variance(f, p);
-        n[size_t(t)] += 1.0;
-      }
-  for (size_t t = 0; t < sum.size(); ++t)
-    sum[t] = n[t] > 0.0 ? sum[t] / n[t] : std::numeric_limits<double>::quiet_NaN();
-  return sum;
+EmitterPool pool_emitters(const std::vector<Film>& films, const std::vector<uint8_t>& emitter) {
+  EmitterPool pool;
+  const size_t tiles = kTiles * kTiles;
+  pool.variance.assign(tiles, 0.0);
+  pool.share.assign(tiles, 0.0);
+  pool.pixels.assign(tiles, 0.0);
+  std::vector<double> n(tiles, 0.0);
+  if (films.empty()) return pool;
+  for (size_t p = 0; p < films[0].sum.size(); ++p) {
+    const size_t t = size_t(tile_of(films[0], p));
+    bool explored = false;
+    for (const Film& f : films) {
+      if (!(f.sum[p].w > 1.0)) continue;
+      explored = true;
+      if (emitter[p]) pool.variance[t] += pixel_variance(f, p), n[t] += 1.0;
+    }
+    pool.pixels[t] += explored ? 1.0 : 0.0;
+    pool.share[t] += explored && emitter[p] ? 1.0 : 0.0;
+  }
+  for (size_t t = 0; t < tiles; ++t) {
+    pool.variance[t] =
+        n[t] > 0.0 ? pool.variance[t] / n[t] : std::numeric_limits<double>::quiet_NaN();
+    pool.share[t] = pool.pixels[t] > 0.0 ? pool.share[t] / pool.pixels[t] : 0.0;
+  }
+  return pool;
 }
 
 double emitter_variance_scale(const std::string& path_sampler, int spp) {
@@ -136,8 +148,10 @@ double emitter_variance_scale(const std::string& path_sampler, int spp) {
 }
 
 ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter, int half,
-                           const std::vector<uint8_t>* in_view, const std::vector<double>* pooled) {
+                           const std::vector<uint8_t>* in_view, const EmitterPool* pool) {
   std::vector<double> tile_sum(kTiles * kTiles, 0.0), tile_n(kTiles * kTiles, 0.0), v;
+  // With a pool: per tile, the variance and count of the pixels not in view.
+  std::vector<double> clear_sum(kTiles * kTiles, 0.0), clear_n(kTiles * kTiles, 0.0);
   double mean = 0.0, mean_var = 0.0, in_view_sum = 0.0;
   double split_sum[2] = {0.0, 0.0}, split_var[2] = {0.0, 0.0}, split_n[2] = {0.0, 0.0};
   size_t clear = 0;
@@ -161,9 +175,11 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
     const double s[3] = {film.sum[p].x, film.sum[p].y, film.sum[p].z};
     const int t = tile_of(film, p);
     double vp = pixel_variance(film, p);
-    if (in_view && pooled && (*in_view)[p] && std::isfinite((*pooled)[size_t(t)])) {
-      vp = (*pooled)[size_t(t)];
+    if (in_view && pool && (*in_view)[p] && std::isfinite(pool->variance[size_t(t)])) {
+      vp = pool->variance[size_t(t)];
       in_view_sum += vp;
+    } else {
+      clear_sum[size_t(t)] += vp, clear_n[size_t(t)] += 1.0;
     }
     v.push_back(vp);
     tile_sum[size_t(t)] += vp;
@@ -182,6 +198,31 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   const double n = double(v.size());
   st.variance = total / n;
   st.emitter_variance = in_view_sum / n;
+  if (in_view && pool) {
+    // The emitters alike for every candidate: each tile its pool's share of them, and the tiles
+    // weighted by the pool's pixels. A tile where this candidate has only pixels in view counts its
+    // mean over all its pixels not in view for the rest.
+    const double clear_all = std::accumulate(clear_sum.begin(), clear_sum.end(), 0.0),
+                 clear_all_n = std::accumulate(clear_n.begin(), clear_n.end(), 0.0);
+    double w = 0.0, sum = 0.0, em = 0.0;
+    for (size_t t = 0; t < tile_sum.size(); ++t) {
+      if (tile_n[t] == 0.0) continue;
+      const double share = std::isfinite(pool->variance[t]) ? pool->share[t] : 0.0;
+      const double in_view_part = share > 0.0 ? share * pool->variance[t] : 0.0;
+      const double rest = clear_n[t] > 0.0    ? clear_sum[t] / clear_n[t]
+                          : clear_all_n > 0.0 ? clear_all / clear_all_n
+                                              : 0.0;
+      tile_n[t] = pool->pixels[t];
+      tile_sum[t] = (in_view_part + (1.0 - share) * rest) * tile_n[t];
+      w += tile_n[t], sum += tile_sum[t];
+      em += in_view_part * tile_n[t];
+    }
+    if (w > 0.0) {
+      st.variance = sum / w;
+      st.emitter_variance = em / w;
+    }
+  }
+  const double tiles_weight = std::accumulate(tile_n.begin(), tile_n.end(), 0.0);
   // The ratio estimate's standard error over the T tiles of the half: the tiles' pixel variances
   // are not identically distributed, so this is conservative for the mean.
   double dev = 0.0, tiles = 0.0;
@@ -191,7 +232,7 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
     dev += d * d;
     tiles += 1.0;
   }
-  const double se = tiles > 1.0 ? std::sqrt(tiles / (tiles - 1.0) * dev) / n : 0.0;
+  const double se = tiles > 1.0 ? std::sqrt(tiles / (tiles - 1.0) * dev) / tiles_weight : 0.0;
   st.variance_lo = std::max(0.0, st.variance - 1.96 * se);
   st.variance_hi = st.variance + 1.96 * se;
   const size_t worst = std::max<size_t>(1, size_t(std::ceil(0.001 * n)));
@@ -199,7 +240,7 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   const double top = std::accumulate(v.begin(), v.begin() + std::ptrdiff_t(worst), 0.0);
   st.tail_share = total > 0.0 ? top / total : 0.0;
   for (size_t t = 0; t < tile_sum.size(); ++t)
-    st.tile_variance.push_back(tile_n[t] > 0.0 ? tile_sum[t] / n
+    st.tile_variance.push_back(tile_n[t] > 0.0 ? tile_sum[t] / tiles_weight
                                                : std::numeric_limits<double>::quiet_NaN());
   if (clear > 0) {
     st.mean = mean / double(clear);
@@ -436,14 +477,14 @@ Measured measure(const std::vector<Film>& films, double emitter_scale) {
   // bright light in view: nearly all of a candidate's measured variance on Veach's MIS scene). It
   // is measured once, pooled over the candidates per tile, and each candidate counts that, scaled
   // to what the render's spp will show of it (emitter_variance_scale).
-  std::vector<double> pooled = pooled_emitter_variance(films, emitter);
-  for (double& v : pooled)
+  EmitterPool pool = pool_emitters(films, emitter);
+  for (double& v : pool.variance)
     v *= emitter_scale;
   for (const Film& f : films) {
-    m.film.push_back(explore_stats(f, off_mean, -1, &emitter, &pooled));
+    m.film.push_back(explore_stats(f, off_mean, -1, &emitter, &pool));
     m.film.back().own_rows = !any_common;
     for (int h = 0; h < 2; ++h) {
-      m.half[h].push_back(explore_stats(f, off_mean, h, &emitter, &pooled));
+      m.half[h].push_back(explore_stats(f, off_mean, h, &emitter, &pool));
       m.half[h].back().own_rows = !any_common;
     }
   }
