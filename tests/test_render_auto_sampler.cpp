@@ -420,10 +420,11 @@ TEST(AutoSampler, TheExplorationRanksByEfficiencyAndItsSamplesArePartOfTheImage)
 // every sample 1), with the exploration on every row, on bands of them (one in three) for the
 // splitting candidate, and on interleaved rows, a third of them each (at 5 spp, below
 // kFilmExplorationMinSpp, two samples each; at 48 spp with full waves, where the film's
-// exploration would cost too much, three); and with the last candidate's probe timed as if it were
-// 10^4 times costlier, which prunes it after its probe: with emitters in view its variance is at
-// least theirs, under point lights alone the rest of its exploration would cost most of the
-// render. (Otherwise the probe counts as free: tests do not time.)
+// exploration would cost too much, three); and with the last candidate timed as if it were 10^4
+// times costlier, which prunes it: with emitters in view before it renders (its pass costs at
+// least tree's, and its variance is at least the emitters'), under point lights alone after its
+// probe (the rest of its exploration would cost most of the render). (Otherwise the probe counts
+// as free: tests do not time.)
 class CombinedImage : public ::testing::TestWithParam<std::tuple<bool, int, bool>> {};
 
 TEST_P(CombinedImage, IsUnbiased) {
@@ -484,18 +485,19 @@ TEST_P(CombinedImage, IsUnbiased) {
     // 10^4 times the cost: with emitters in view it cannot win; without, the rest of its
     // exploration costs more than kCostlyExplorationShare of the render, and on interleaved rows
     // its probe's variance does not show it significantly more efficient.
-    const bool pruned = costly;
+    const bool pruned = costly, unexplored = costly && emitters;
     for (size_t i = 0; i < 3; ++i) {
       const PilotResult& c = r.choice.candidates[i];
       const double share = interleaved || (period > 1 && i == 2) ? 16.0 / 48.0 : 1.0;
       EXPECT_EQ(c.pruned, pruned && i == 2) << describe(r.choice);
       // a probe: two of kProbeParts bands of its rows (on bands, both of its 2 bands of 8 rows)
-      EXPECT_DOUBLE_EQ(c.explored_share,
-                       c.pruned && period <= 1 ? share * 2.0 / kProbeParts : share);
+      EXPECT_DOUBLE_EQ(c.explored_share, unexplored && c.pruned    ? 0.0
+                                         : c.pruned && period <= 1 ? share * 2.0 / kProbeParts
+                                                                   : share);
       if (c.pruned) {
         EXPECT_NE(r.choice.chosen.label, c.label);
         // a second sample where it measured a variance
-        EXPECT_EQ(c.samples, interleaved && !emitters ? 2 : 1);
+        EXPECT_EQ(c.samples, unexplored ? 0 : interleaved && !emitters ? 2 : 1);
       }
     }
     for (const double4& x : r.film.sum) // every pixel, explored or not, has spp samples

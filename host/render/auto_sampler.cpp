@@ -507,6 +507,24 @@ size_t best_explored(const std::vector<PilotResult>& cand, size_t i, const Measu
   return best;
 }
 
+// Whether the costly candidate `i` cannot be the most efficient before it renders anything: it
+// splits `tree`'s light tree (a cut member is a pick of tree's), so its pass costs at least
+// `tree`'s, and with the emitter pixels' variance, which every candidate has, that bounds its
+// efficiency (may_beat). Where emitters in view hold most of the error (default.json's and the
+// Cornell boxes' direct light, Veach's MIS scene), its program, first launches and probe are
+// spared.
+bool costly_cannot_win(const std::vector<PilotResult>& cand, size_t i,
+                       const std::vector<Film>& films, double emitter_scale, double probe_cost) {
+  size_t tree = i;
+  for (size_t j = 0; j < i; ++j)
+    if (cand[j].options.light_sampler == "tree" && !cand[j].pruned) tree = j;
+  if (tree == i || cand[tree].pass_seconds <= 0.0) return false;
+  const Measured m = measure(films, emitter_scale);
+  const size_t b = best_explored(cand, i, m);
+  return b < i && !may_beat(m.film[b].emitter_variance, probe_cost * cand[tree].pass_seconds,
+                            1.0 / (m.film[b].variance * cand[b].pass_seconds));
+}
+
 // Candidate `i` (its probe measured in `m.film[i]`, at `pass_seconds` per pass) against the best
 // before it: -1 if that is significantly more efficient, 1 if `i` is, else 0 (the paired tile
 // comparison of choose_candidate).
@@ -598,6 +616,21 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   std::vector<Gap> gaps; // what the exploration leaves on some rows for the chosen candidate
   for (size_t i = 0; i < cand.size(); ++i) {
     PilotResult& c = cand[i];
+    if (i + 1 == cand.size() && i > 0 &&
+        costly_cannot_win(cand, i, films, emitter_scale, probe_cost)) {
+      // Pruned before it renders (its program is not even loaded): the chosen candidate renders
+      // its sample indices on its rows.
+      c.pruned = true;
+      c.first_sample = interleaved ? settings.first_sample : next;
+      c.explored_share = 0.0;
+      if (interleaved) gaps.push_back({c.bands, settings.first_sample, k});
+      Film none = films[0];
+      std::fill(none.sum.begin(), none.sum.end(), double4{});
+      std::fill(none.sumsq.begin(), none.sumsq.end(), double4{});
+      std::fill(none.counts.begin(), none.counts.end(), double4{});
+      films.push_back(std::move(none));
+      continue;
+    }
     if (!same_sampler(renderer.options(), c.options)) renderer.set_light_sampler(c.options);
     if (interleaved) next = settings.first_sample; // the same indices, on other rows
     c.first_sample = next;
@@ -796,9 +829,10 @@ std::string describe(const AutoChoice& choice) {
         "{:.2g}/{:.2g}){}",
         i ? "," : "", c.label, c.efficiency, c.efficiency_lo, c.efficiency_hi, c.pass_seconds,
         100.0 * c.explored_share, c.stats.tail_share, c.weight[0], c.weight[1],
-        c.missed_tail ? " (missed its tail: not ranked)"
-        : c.pruned    ? " (pruned after its probe)"
-                      : "");
+        c.missed_tail                ? " (missed its tail: not ranked)"
+        : c.pruned && c.samples == 0 ? " (pruned before it rendered: it costs more than `tree`)"
+        : c.pruned                   ? " (pruned after its probe)"
+                                     : "");
   }
   return s + ")";
 }
