@@ -264,7 +264,7 @@ namespace {
 // variance too).
 //
 // Measured on different rows (interleaved), two candidates' means also differ by what those rows
-// show: on default.json at 128 rows, every third row's non-emitter mean differs from the next
+// show: on default.json at 256 rows, every third row's non-emitter mean differs from the next
 // one's by 2.5% (3-5 standard errors of 2 samples per pixel, whichever candidate renders them).
 // That part of the variance is estimated from each candidate's own rows split in two (every other
 // row: the difference beyond the samples' variance is the rows' structure; a missed tail lowers
