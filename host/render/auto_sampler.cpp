@@ -152,7 +152,7 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   std::vector<double> tile_sum(kTiles * kTiles, 0.0), tile_n(kTiles * kTiles, 0.0), v;
   // With a pool: per tile, the variance and count of the pixels not in view.
   std::vector<double> clear_sum(kTiles * kTiles, 0.0), clear_n(kTiles * kTiles, 0.0);
-  double mean = 0.0, mean_var = 0.0, in_view_sum = 0.0;
+  double mean = 0.0, mean_var = 0.0;
   double split_sum[2] = {0.0, 0.0}, split_var[2] = {0.0, 0.0}, split_n[2] = {0.0, 0.0};
   size_t clear = 0;
   // Each row's rank among the rows with samples (-1: none), for the row split.
@@ -177,7 +177,6 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
     double vp = pixel_variance(film, p);
     if (in_view && pool && (*in_view)[p] && std::isfinite(pool->variance[size_t(t)])) {
       vp = pool->variance[size_t(t)];
-      in_view_sum += vp;
     } else {
       clear_sum[size_t(t)] += vp, clear_n[size_t(t)] += 1.0;
     }
@@ -197,7 +196,6 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
   const double total = std::accumulate(v.begin(), v.end(), 0.0);
   const double n = double(v.size());
   st.variance = total / n;
-  st.emitter_variance = in_view_sum / n;
   if (in_view && pool) {
     // The emitters alike for every candidate: each tile its pool's share of them, and the tiles
     // weighted by the pool's pixels. A tile where this candidate has only pixels in view counts its
@@ -507,22 +505,24 @@ size_t best_explored(const std::vector<PilotResult>& cand, size_t i, const Measu
   return best;
 }
 
-// Whether the costly candidate `i` cannot be the most efficient before it renders anything: it
-// splits `tree`'s light tree (a cut member is a pick of tree's), so its pass costs at least
-// `tree`'s, and with the emitter pixels' variance, which every candidate has, that bounds its
-// efficiency (may_beat). Where emitters in view hold most of the error (default.json's and the
-// Cornell boxes' direct light, Veach's MIS scene), its program, first launches and probe are
-// spared.
-bool costly_cannot_win(const std::vector<PilotResult>& cand, size_t i,
-                       const std::vector<Film>& films, double emitter_scale, double probe_cost) {
-  size_t tree = i;
-  for (size_t j = 0; j < i; ++j)
-    if (cand[j].options.light_sampler == "tree" && !cand[j].pruned) tree = j;
-  if (tree == i || cand[tree].pass_seconds <= 0.0) return false;
-  const Measured m = measure(films, emitter_scale);
-  const size_t b = best_explored(cand, i, m);
-  return b < i && !may_beat(m.film[b].emitter_variance, probe_cost * cand[tree].pass_seconds,
+// Whether candidate `i`, at `pass_seconds` per pass, may be more efficient than `b`, the best
+// explored before it (best_explored; `i` if none): its variance is at least the emitter pixels'
+// part, which every candidate has (may_beat).
+bool may_beat_best(const std::vector<PilotResult>& cand, size_t i, size_t b, const Measured& m,
+                   double pass_seconds) {
+  return b == i || may_beat(m.film[b].emitter_variance, pass_seconds,
                             1.0 / (m.film[b].variance * cand[b].pass_seconds));
+}
+
+// The time per pass of `tree` among the candidates before `i`, 0 if it was not explored. The
+// costly candidate splits tree's light tree (a cut member is a pick of tree's), so its pass costs
+// at least that: with may_beat_best, a bound on its efficiency before it renders anything. Where
+// emitters in view hold most of the error (default.json's and the Cornell boxes' direct light) its
+// program, first launches and probe are spared.
+double tree_pass_seconds(const std::vector<PilotResult>& cand, size_t i) {
+  for (size_t j = 0; j < i; ++j)
+    if (cand[j].options.light_sampler == "tree" && !cand[j].pruned) return cand[j].pass_seconds;
+  return 0.0;
 }
 
 // Candidate `i` (its probe measured in `m.film[i]`, at `pass_seconds` per pass) against the best
@@ -616,8 +616,13 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   std::vector<Gap> gaps; // what the exploration leaves on some rows for the chosen candidate
   for (size_t i = 0; i < cand.size(); ++i) {
     PilotResult& c = cand[i];
-    if (i + 1 == cand.size() && i > 0 &&
-        costly_cannot_win(cand, i, films, emitter_scale, probe_cost)) {
+    // The last, costly candidate against the most efficient explored before it.
+    const bool costly_candidate = i + 1 == cand.size() && i > 0;
+    const Measured before = costly_candidate ? measure(films, emitter_scale) : Measured{};
+    const size_t b = costly_candidate ? best_explored(cand, i, before) : i;
+    const double tree_pass = tree_pass_seconds(cand, i);
+    if (costly_candidate && tree_pass > 0.0 &&
+        !may_beat_best(cand, i, b, before, probe_cost * tree_pass)) {
       // Pruned before it renders (its program is not even loaded): the chosen candidate renders
       // its sample indices on its rows.
       c.pruned = true;
@@ -637,7 +642,7 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     rs.first_sample = next;
     rs.spp = 1;
     const std::vector<RowBands> parts =
-        i + 1 == cand.size() && i > 0 ? probe_parts(c.bands, fh) : std::vector<RowBands>();
+        costly_candidate ? probe_parts(c.bands, fh) : std::vector<RowBands>();
     Film film;
     double first_pass = 0.0; // device seconds of the first pass
     int rendered = 1;        // samples per pixel on its rows before the timed renders
@@ -661,10 +666,7 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       // where emitters are in view (may_beat), and the rest of this one's exploration, in passes
       // over the film, is weighed against kCostlyExplorationShare of the render that the best
       // would make of the user's samples.
-      const Measured before = measure(films, emitter_scale);
-      const size_t b = best_explored(cand, i, before);
-      bool keep = b == i || may_beat(before.film[b].emitter_variance, probe_cost * pass,
-                                     1.0 / (before.film[b].variance * cand[b].pass_seconds));
+      bool keep = may_beat_best(cand, i, b, before, probe_cost * pass);
       const double share0 = double(covered_rows(parts[0].packed(), fh)) / double(fh);
       const double rest = interleaved
                               ? double(k) * c.explored_share - share0 - 2.0 * share1
