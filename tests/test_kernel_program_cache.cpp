@@ -1,7 +1,7 @@
 // The wavefront program from the program cache (ClRuntime::build_program, host/cl/program_cache.h)
 // is the program built from source: it renders the same film bit for bit. A program's entry
-// depends on its build options and on every kernel source and header; a corrupt entry is rebuilt
-// and replaced without an error.
+// depends on its build options and on every kernel source and header, not on where the sources
+// are; a corrupt entry is rebuilt and replaced without an error.
 #include "cl/program_cache.h"
 #include "cl/runtime.h"
 #include "render/features.h"
@@ -111,6 +111,23 @@ TEST_F(ProgramCacheKernelTest, EntryDependsOnEveryHeader) {
   rt_.build_program(wavefront_kernel_files(), options(), &cached);
   EXPECT_FALSE(cached);
   EXPECT_EQ(entries(), 2u);
+}
+
+TEST_F(ProgramCacheKernelTest, EntryDoesNotDependOnWhereTheSourcesAre) {
+  // Two checkouts of the same sources (a clean clone in CI, an installed copy): one entry.
+  fs::create_directories(dir_);
+  for (const char* copy : {"a", "b"}) {
+    fs::create_directories(dir_ / copy / "cl");
+    fs::copy(kernel_dir(), dir_ / copy / "cl", fs::copy_options::recursive);
+  }
+  bool cached = true;
+  setenv("CANOPY_KERNEL_DIR", (dir_ / "a" / "cl").c_str(), 1);
+  rt_.build_program(wavefront_kernel_files(), options(), &cached);
+  EXPECT_FALSE(cached);
+  setenv("CANOPY_KERNEL_DIR", (dir_ / "b" / "cl").c_str(), 1);
+  rt_.build_program(wavefront_kernel_files(), options(), &cached);
+  EXPECT_TRUE(cached);
+  EXPECT_EQ(entries(), 1u);
 }
 
 TEST_F(ProgramCacheKernelTest, CorruptEntryIsRebuiltSilently) {

@@ -95,19 +95,6 @@ TEST_F(ProgramCacheTest, EntryNamesDependOnEveryPartOfTheKey) {
   EXPECT_EQ(cache.entry_path(key_), cache.entry_path(std::string(key_)));
 }
 
-TEST_F(ProgramCacheTest, DirectoryDigestSeesEveryFile) {
-  fs::create_directories(dir_ / "sub");
-  write(dir_ / "a.h", "int a;");
-  write(dir_ / "sub" / "b.h", "int b;");
-  const std::string d0 = directory_digest(dir_);
-  EXPECT_EQ(directory_digest(dir_), d0);
-  write(dir_ / "sub" / "b.h", "int b; ");
-  const std::string d1 = directory_digest(dir_);
-  EXPECT_NE(d1, d0);
-  write(dir_ / "sub" / "c.h", "");
-  EXPECT_NE(directory_digest(dir_), d1);
-}
-
 TEST_F(ProgramCacheTest, LeastRecentlyUsedEntriesAreRemoved) {
   ProgramCache cache(dir_);
   cache.max_entries = 3;

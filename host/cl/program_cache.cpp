@@ -79,21 +79,6 @@ fs::path program_cache_dir() {
   return {};
 }
 
-std::string directory_digest(const fs::path& dir) {
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::end(it);
-       it.increment(ec))
-    if (it->is_regular_file(ec)) files.push_back(it->path());
-  std::sort(files.begin(), files.end());
-  Digest d;
-  for (const fs::path& f : files) {
-    d.add(fs::relative(f, dir, ec).generic_string());
-    d.add(read_all(f));
-  }
-  return d.hex();
-}
-
 fs::path ProgramCache::entry_path(const std::string& key) const {
   Digest d;
   d.add(key);

@@ -33,10 +33,6 @@ private:
 // $HOME/.cache/canopy. Empty when there is none.
 std::filesystem::path program_cache_dir();
 
-// The digest of every file under `dir` (names and contents, in path order): the headers a program
-// built with "-I dir" may include.
-std::string directory_digest(const std::filesystem::path& dir);
-
 class ProgramCache {
 public:
   explicit ProgramCache(std::filesystem::path dir) : dir_(std::move(dir)) {}

@@ -1,5 +1,6 @@
 #include "cl/runtime.h"
 
+#include "cl/kernel_source.h"
 #include "cl/program_cache.h"
 
 #include <fmt/format.h>
@@ -7,10 +8,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
-#include <fstream>
 #include <optional>
 #include <sched.h>
-#include <sstream>
 #include <unistd.h>
 
 namespace canopy {
@@ -20,14 +19,6 @@ namespace {
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
   return s;
-}
-
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw ClError(fmt::format("{}: cannot open kernel source", p.string()));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 } // namespace
@@ -229,11 +220,9 @@ std::string ClRuntime::device_signature() const {
 }
 
 std::string ClRuntime::build_options(const std::string& options) const {
-  // PoCL passes the option string to clang verbatim: no quotes, so escape spaces instead.
-  std::string inc;
-  for (char c : kernel_dir().string())
-    inc += c == ' ' ? std::string("\\ ") : std::string(1, c);
-  std::string opts = fmt::format("-I {} -cl-std=CL1.2 -cl-kernel-arg-info {}", inc, options);
+  // No "-I": the sources come with their headers expanded (cl/kernel_source.h), so that neither
+  // the options nor the text name this checkout's path.
+  std::string opts = fmt::format("-cl-std=CL1.2 -cl-kernel-arg-info {}", options);
   // The tests build kernels with -Werror (a warning in a kernel is a defect like one in the host
   // code); users' builds stay tolerant of whatever a newer PoCL clang may warn about.
   if (const char* w = std::getenv("CANOPY_KERNEL_WERROR"); w && *w && std::string(w) != "0")
@@ -255,19 +244,17 @@ cl::Program ClRuntime::build_from_source(const std::string& source, const std::s
 cl::Program ClRuntime::build_program(const std::vector<std::string>& files,
                                      const std::string& options, bool* from_cache) const {
   std::filesystem::path dir = kernel_dir();
-  std::string source;
-  for (const auto& f : files)
-    source += read_text(dir / f) + "\n";
+  const std::string source = read_kernel_sources(dir, files);
   const std::string opts = build_options(options);
   if (from_cache) *from_cache = false;
   const std::filesystem::path cache_dir = program_cache_dir();
   if (cache_dir.empty()) return build_from_source(source, opts);
 
-  // The headers are part of the key: the files include them from the kernel directory.
+  // The source holds every header it includes: its text, the options and the device are the key.
   Digest text;
   text.add(source);
-  const std::string key = fmt::format("{}options {}\nsource {}\nheaders {}\n", device_signature(),
-                                      opts, text.hex(), directory_digest(dir));
+  const std::string key =
+      fmt::format("{}options {}\nsource {}\n", device_signature(), opts, text.hex());
   const ProgramCache cache(cache_dir);
   if (std::optional<std::vector<unsigned char>> binary = cache.load(key)) {
     try {
@@ -287,7 +274,8 @@ cl::Program ClRuntime::build_program(const std::vector<std::string>& files,
 
 cl::Program ClRuntime::build_program_source(const std::string& source,
                                             const std::string& options) const {
-  return build_from_source(source, build_options(options));
+  return build_from_source(expand_kernel_includes(source, "source", kernel_dir()),
+                           build_options(options));
 }
 
 cl::Event enqueue_1d(cl::CommandQueue& q, const cl::Kernel& k, size_t n, size_t local) {

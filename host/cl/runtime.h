@@ -50,12 +50,13 @@ public:
   // Otherwise the first device whose device or platform name contains it (case-insensitive).
   explicit ClRuntime(const std::string& device_name = "");
 
-  // Builds a program from the given files (relative to kernel_dir()) with "-I <kernel_dir>",
-  // "-cl-kernel-arg-info" (kernel arguments are bound by name, host/cl/kernel_args.h) and `options`
-  // appended. Throws ClError holding the build log on failure. The program is loaded from the
-  // program cache (host/cl/program_cache.h) when it holds it; otherwise it is compiled, every
-  // kernel included (PoCL compiles a kernel's work-group function when asked for the binary, not
-  // at its first launch), and stored there. `from_cache`, if given, tells which happened.
+  // Builds a program from the given files (relative to kernel_dir(), their includes expanded:
+  // host/cl/kernel_source.h) with "-cl-kernel-arg-info" (kernel arguments are bound by name,
+  // host/cl/kernel_args.h) and `options` appended. Throws ClError holding the build log on failure.
+  // The program is loaded from the program cache (host/cl/program_cache.h) when it holds it;
+  // otherwise it is compiled, every kernel included (PoCL compiles a kernel's work-group function
+  // when asked for the binary, not at its first launch), and stored there. `from_cache`, if given,
+  // tells which happened.
   cl::Program build_program(const std::vector<std::string>& files, const std::string& options = "",
                             bool* from_cache = nullptr) const;
   // The same for source text (test and benchmark kernels that include headers from cl/).

@@ -3,6 +3,7 @@
 // compiler's log (the returned program is then unbuilt: check HasFailure()).
 #pragma once
 
+#include "cl/kernel_source.h"
 #include "cl/runtime.h"
 
 #include <gtest/gtest.h>
@@ -13,8 +14,8 @@ namespace canopy::test {
 
 inline cl::Program build_probe_program(ClRuntime& rt, const char* source,
                                        const std::string& options) {
-  cl::Program program(rt.context(), source);
-  std::string opts = "-I " + kernel_dir().string() + " -cl-std=CL1.2 -Werror " + options;
+  cl::Program program(rt.context(), expand_kernel_includes(source, "probe", kernel_dir()));
+  std::string opts = "-cl-std=CL1.2 -Werror " + options;
   try {
     program.build({rt.device()}, opts.c_str());
   } catch (const cl::Error&) {
