@@ -482,6 +482,13 @@ int run_render(const RenderArgs& args) {
       a["reason"] = choice->reason;
       a["pilot_seconds"] = choice->pilot_seconds;
       a["explored_samples"] = choice->explored_samples;
+      // JSON has no infinity: a gain without a measurable error is written as null.
+      auto finite = [](double g) {
+        return std::isfinite(g) ? nlohmann::json(g) : nlohmann::json();
+      };
+      a["stratification_gain"] = {
+          {"other", {finite(choice->gain[0].other), finite(choice->gain[1].other)}},
+          {"emitter", {finite(choice->gain[0].emitter), finite(choice->gain[1].emitter)}}};
       for (const PilotResult& c : choice->candidates)
         a["candidates"].push_back(
             {{"label", c.label},

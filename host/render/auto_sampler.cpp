@@ -75,15 +75,17 @@ bool same_sampler(const RendererOptions& a, const RendererOptions& b) {
          a.max_cut == b.max_cut && a.orientation_term == b.orientation_term && a.mis == b.mis;
 }
 
-// Film `b`'s samples added to `a`'s (the same pixels, disjoint sample ranges), `b`'s sums scaled
-// by `w` per pixel (sumsq by w^2) when given.
-void add_samples(Film& a, const Film& b, const std::vector<double>* w = nullptr) {
+// Film `b`'s samples added to `a`'s (the same pixels), `b`'s sums scaled by `w` per pixel (sumsq
+// by w^2) when given; its sample counts too unless `count` is false (samples that share the
+// pixel's mass with `a`'s: their weights make up for them).
+void add_samples(Film& a, const Film& b, const std::vector<double>* w = nullptr,
+                 bool count = true) {
   for (size_t p = 0; p < a.sum.size(); ++p) {
     const double s = w ? (*w)[p] : 1.0;
     double4 &x = a.sum[p], &q = a.sumsq[p], &c = a.counts[p];
     const double4 &y = b.sum[p], &r = b.sumsq[p], &d = b.counts[p];
-    x.x += s * y.x, x.y += s * y.y, x.z += s * y.z, x.w += y.w;
-    q.x += s * s * r.x, q.y += s * s * r.y, q.z += s * s * r.z, q.w += r.w;
+    x.x += s * y.x, x.y += s * y.y, x.z += s * y.z, x.w += count ? y.w : 0.0;
+    q.x += s * s * r.x, q.y += s * s * r.y, q.z += s * s * r.z, q.w += count ? r.w : 0.0;
     c.x += d.x, c.y += d.y, c.z += d.z, c.w += d.w;
   }
 }
@@ -115,6 +117,36 @@ double pixel_variance(const Film& film, size_t p) {
 }
 
 } // namespace
+
+StratificationGain stratification_gain(const Film& a, const Film& b,
+                                       const std::vector<uint8_t>& in_view, int half) {
+  double independent[2] = {0.0, 0.0}, whole[2] = {0.0, 0.0};
+  for (size_t p = 0; p < a.sum.size(); ++p) {
+    const double na = a.sum[p].w, nb = b.sum[p].w;
+    if (half_of(a, p) != half || na <= 0.0 || nb <= 0.0) continue;
+    const double n = na + nb;
+    const double sa[3] = {a.sum[p].x, a.sum[p].y, a.sum[p].z};
+    const double sb[3] = {b.sum[p].x, b.sum[p].y, b.sum[p].z};
+    const double q[3] = {a.sumsq[p].x + b.sumsq[p].x, a.sumsq[p].y + b.sumsq[p].y,
+                         a.sumsq[p].z + b.sumsq[p].z};
+    double var = 0.0, diff = 0.0;
+    for (int ch = 0; ch < 3; ++ch) {
+      const double s = sa[ch] + sb[ch], d = sa[ch] / na - sb[ch] / nb;
+      var += std::max(0.0, (q[ch] - s * s / n) / (n - 1.0)) / 3.0;
+      diff += d * d / 3.0;
+    }
+    const int e = in_view[p] ? 1 : 0;
+    independent[e] += var / n;
+    // Two independent parts: var(mean) = var(difference) x na nb / n^2.
+    whole[e] += diff * na * nb / (n * n);
+  }
+  // A whole set without error (a constant pixel, or perfect stratification): other samples
+  // can only add error, and weigh nothing.
+  auto gain = [](double ind, double w) {
+    return w > 0.0 ? std::max(1.0, ind / w) : ind > 0.0 ? HUGE_VAL : 1.0;
+  };
+  return {gain(independent[1], whole[1]), gain(independent[0], whole[0])};
+}
 
 EmitterPool pool_emitters(const std::vector<Film>& films, const std::vector<uint8_t>& emitter) {
   EmitterPool pool;
@@ -420,17 +452,22 @@ bool may_beat(double emitter_variance, double pass_seconds, double best_efficien
 
 namespace {
 
-// Sample indices [first, first + spp) on bands of rows, which the chosen candidate renders.
-struct Gap {
-  RowBands bands;
-  int first = 0, spp = 0;
-};
+// The rows of the film that bands `b` do not cover, as bands.
+std::vector<RowBands> other_rows(const RowBands& b) {
+  std::vector<RowBands> out;
+  if (b.all()) return out;
+  if (b.first > 0) out.push_back(RowBands{b.height, b.period, 0, b.first});
+  if (b.first + b.count < b.period)
+    out.push_back(RowBands{b.height, b.period, b.first + b.count, b.period - b.first - b.count});
+  return out;
+}
 
-// The bands of a period that `b` (count 1, first 0) does not cover.
-RowBands other_bands(RowBands b) {
-  b.first += b.count;
-  b.count = b.period - b.count;
-  return b;
+Film empty_like(const Film& f) {
+  Film e = f;
+  std::fill(e.sum.begin(), e.sum.end(), double4{});
+  std::fill(e.sumsq.begin(), e.sumsq.end(), double4{});
+  std::fill(e.counts.begin(), e.counts.end(), double4{});
+  return e;
 }
 
 // A candidate's rows `b` (count 1) in kProbeParts parts, each one band in kProbeParts of its:
@@ -540,7 +577,8 @@ int against_best(const std::vector<PilotResult>& cand, size_t i, const Measured&
 } // namespace
 
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
-                       const RenderSettings& settings, int explore_period, double probe_cost) {
+                       const RenderSettings& settings, int explore_period, double probe_cost,
+                       Film* chosen_samples) {
   const auto t0 = Clock::now();
   AutoRender out;
   AutoChoice& choice = out.choice;
@@ -611,9 +649,8 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
   // The faster gives the time per pass (robust to a moment of other load on the machine). The
   // last, costly candidate's first pass starts with its probe (kProbeParts), timed.
   const double emitter_scale = emitter_variance_scale(base.path_sampler, settings.spp);
-  int next = settings.first_sample, explored_end = next;
+  int next = settings.first_sample;
   std::vector<Film> films;
-  std::vector<Gap> gaps; // what the exploration leaves on some rows for the chosen candidate
   for (size_t i = 0; i < cand.size(); ++i) {
     PilotResult& c = cand[i];
     // The last, costly candidate against the most efficient explored before it.
@@ -626,18 +663,15 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       // Pruned before it renders (its program is not even loaded): the chosen candidate renders
       // its sample indices on its rows.
       c.pruned = true;
-      c.first_sample = interleaved ? settings.first_sample : next;
+      c.first_sample = settings.first_sample;
       c.explored_share = 0.0;
-      if (interleaved) gaps.push_back({c.bands, settings.first_sample, k});
-      Film none = films[0];
-      std::fill(none.sum.begin(), none.sum.end(), double4{});
-      std::fill(none.sumsq.begin(), none.sumsq.end(), double4{});
-      std::fill(none.counts.begin(), none.counts.end(), double4{});
-      films.push_back(std::move(none));
+      films.push_back(empty_like(films[0]));
       continue;
     }
     if (!same_sampler(renderer.options(), c.options)) renderer.set_light_sampler(c.options);
-    if (interleaved) next = settings.first_sample; // the same indices, on other rows
+    // Every candidate explores the pixel's first sample indices: the chosen one's exploration is
+    // then the start of its own set of the user's samples (see the file comment).
+    next = settings.first_sample;
     c.first_sample = next;
     rs.first_sample = next;
     rs.spp = 1;
@@ -688,24 +722,12 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
       } else if (keep) {
         keep = !costly; // one sample per pixel: no variance to weigh against the cost
       }
-      if (!keep) {
-        // Its probe is all it renders. The chosen candidate renders the probe's sample indices
-        // on the candidate's other rows, and the indices it would have rendered after.
+      if (!keep) { // its probe is all it renders
         c.pruned = true;
         c.pass_seconds = pass;
         c.seconds = probe;
         c.samples = probed;
         c.explored_share = share0 + share1;
-        for (size_t j = 2; j < parts.size(); ++j)
-          gaps.push_back({parts[j], s0, interleaved ? k : 1});
-        if (interleaved) {
-          gaps.push_back({parts[0], s0 + 1, k - 1});
-          gaps.push_back({parts[1], s0 + probed, k - probed});
-        } else if (!c.bands.all()) {
-          gaps.push_back({other_bands(c.bands), s0, 1});
-        }
-        explored_end = std::max(explored_end, next + probed);
-        if (!interleaved) next += 1;
         films.push_back(std::move(film));
         continue;
       }
@@ -743,12 +765,10 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     // On interleaved rows the untimed pass is the timed passes' size too: the faster counts.
     if (interleaved) c.pass_seconds = std::min(c.pass_seconds, first_pass / c.explored_share);
     c.samples = next - c.first_sample;
-    explored_end = std::max(explored_end, next);
-    if (!interleaved && !c.bands.all()) // the chosen one renders its indices on the other bands
-      gaps.push_back({other_bands(c.bands), c.first_sample, c.samples});
     films.push_back(std::move(film));
   }
-  choice.explored_samples = explored_end - settings.first_sample;
+  for (const PilotResult& c : cand)
+    choice.explored_samples = std::max(choice.explored_samples, c.samples);
 
   // Measurements over the film and over each half.
   const Measured m = measure(films, emitter_scale);
@@ -774,47 +794,70 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     renderer.set_light_sampler(cand[best].options);
   choice.pilot_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
-  // The chosen candidate renders the rest: the samples after the exploration's everywhere, and
-  // the gaps: the sample indices of a candidate that explored on bands of rows on the other rows,
-  // and those a pruned candidate did not render. Its samples share what is left of each pixel's
-  // mass: (spp - sum of the exploration's weighted samples) / (its samples), at least 1 each.
+  // The chosen candidate renders the rest of every pixel's set of the user's sample indices, in
+  // two parts for the gain measurement: [first, mid) (its exploration on its rows, the rest
+  // everywhere) and [mid, end).
+  const PilotResult& c = cand[best];
+  const int first = settings.first_sample, end = first + settings.spp;
+  const int mid = first + std::max(c.samples, settings.spp / 2);
   rs = settings;
-  rs.first_sample = explored_end;
-  rs.spp = settings.first_sample + settings.spp - explored_end;
-  Film rest = renderer.render(rs);
-  for (const Gap& g : gaps) {
-    if (g.spp == 0 || covered_rows(g.bands.packed(), fh) == 0) continue;
-    rs.first_sample = g.first;
-    rs.spp = g.spp;
-    rs.bands = g.bands;
-    add_samples(rest, renderer.render(rs));
-  }
-  // A candidate's weight at a pixel: 1 where another candidate's camera rays saw an emitter there
-  // (that pixel's noise is mostly the emitter's edge, the same for every candidate, and unequal
-  // weights on equally good samples add variance), unless it missed its tail; else its weight in
-  // the pixel's half. Both depend on other samples than the ones they weight.
-  const size_t npixels = rest.sum.size();
-  std::vector<std::vector<double>> wc(cand.size(), std::vector<double>(npixels));
-  std::vector<double> w(npixels, double(settings.spp));
-  for (size_t i = 0; i < cand.size(); ++i)
-    for (size_t p = 0; p < npixels; ++p) {
-      bool edge = false;
-      for (size_t d = 0; d < cand.size(); ++d)
-        edge = edge || (d != i && films[d].counts[p].z > 0.0);
-      const double wh = cand[i].weight[half_of(rest, p)];
-      wc[i][p] = edge && wh > 0.0 ? 1.0 : wh; // a missed tail weighs nothing anywhere
-      w[p] -= wc[i][p] * films[i].sum[p].w;   // its samples at p: 0 off the explored rows
-    }
+  auto render_range = [&](Film& to, int from, int until, const RowBands& b) {
+    if (until <= from || covered_rows(b.packed(), fh) == 0) return;
+    rs.first_sample = from;
+    rs.spp = until - from;
+    rs.bands = b;
+    Film f = renderer.render(rs);
+    if (to.sum.empty())
+      to = std::move(f);
+    else
+      add_samples(to, f);
+  };
+  Film part[2];
+  part[0] = films[best];
+  render_range(part[0], first + c.samples, mid, RowBands{});
+  for (const RowBands& b : other_rows(c.bands))
+    render_range(part[0], first, first + c.samples, b);
+  render_range(part[1], mid, end, RowBands{});
+  if (part[1].sum.empty()) part[1] = empty_like(part[0]);
+
+  // The other candidates' samples, at the same indices as the chosen one's, are extra. Each is
+  // weighted against a sample of the chosen one by its relative inverse variance (its weight in
+  // the pixel's half, or 1 where the chosen one's camera rays saw an emitter: that noise is the
+  // emitter's edge, the same for every candidate), divided by the chosen one's stratification
+  // gain over that kind of pixel. All of it is measured on the other half of the film.
+  const size_t npixels = part[0].sum.size();
+  std::vector<uint8_t> in_view(npixels);
   for (size_t p = 0; p < npixels; ++p)
-    w[p] /= rest.sum[p].w;
-  out.film = std::move(rest);
-  for (size_t p = 0; p < w.size(); ++p) {
+    in_view[p] = part[0].counts[p].z > 0.0 || part[1].counts[p].z > 0.0;
+  for (int h = 0; h < 2; ++h)
+    choice.gain[h] = stratification_gain(part[0], part[1], in_view, h);
+  std::vector<std::vector<double>> wc(cand.size(), std::vector<double>(npixels, 0.0));
+  std::vector<double> scale(npixels, 1.0);
+  for (size_t p = 0; p < npixels; ++p) {
+    const int h = half_of(part[0], p);
+    const StratificationGain& g = choice.gain[1 - h];
+    double extra = 0.0; // the other candidates' samples at p, in samples of the chosen one
+    for (size_t i = 0; i < cand.size(); ++i) {
+      if (i == best) continue;
+      const double wh = cand[i].weight[h];
+      wc[i][p] = in_view[p] ? (wh > 0.0 ? 1.0 / g.emitter : 0.0) : wh / g.other;
+      extra += wc[i][p] * films[i].sum[p].w;
+    }
+    scale[p] = settings.spp / (settings.spp + extra);
+    for (size_t i = 0; i < cand.size(); ++i)
+      wc[i][p] *= scale[p];
+  }
+  out.film = std::move(part[0]);
+  add_samples(out.film, part[1]);
+  if (chosen_samples) *chosen_samples = out.film;
+  for (size_t p = 0; p < npixels; ++p) {
     double4 &x = out.film.sum[p], &q = out.film.sumsq[p];
-    x.x *= w[p], x.y *= w[p], x.z *= w[p];
-    q.x *= w[p] * w[p], q.y *= w[p] * w[p], q.z *= w[p] * w[p];
+    const double w = scale[p];
+    x.x *= w, x.y *= w, x.z *= w;
+    q.x *= w * w, q.y *= w * w, q.z *= w * w;
   }
   for (size_t i = 0; i < cand.size(); ++i)
-    add_samples(out.film, films[i], &wc[i]);
+    if (i != best) add_samples(out.film, films[i], &wc[i], /*count=*/false);
   return out;
 }
 
@@ -836,7 +879,9 @@ std::string describe(const AutoChoice& choice) {
         : c.pruned                   ? " (pruned after its probe)"
                                      : "");
   }
-  return s + ")";
+  return s + fmt::format("; stratification gain {:.3g}/{:.3g}, emitters {:.3g}/{:.3g})",
+                         choice.gain[0].other, choice.gain[1].other, choice.gain[0].emitter,
+                         choice.gain[1].emitter);
 }
 
 } // namespace canopy

@@ -5,11 +5,18 @@
 // `tree` wins where a point's important lights are few, splitting where they are many, `power`
 // where the tree's pick costs more than it buys. The exploration measures which case a scene is.
 //
-// The image stays exactly unbiased. The film is split into two halves (a checkerboard of tiles);
-// a candidate's exploration samples in one half are weighted by its variance relative to the
-// others' measured on the other half only (independent samples), and the chosen candidate's samples
-// get whatever weight is left of the pixel's unit mass, fixed before they are drawn. A candidate
-// far noisier than the rest (power on a city) then adds almost nothing to the image.
+// The image stays exactly unbiased, and the chosen candidate's samples stay stratified: every
+// candidate explores the pixel's first sample indices, so the chosen one's exploration is the
+// start of its own set and it renders the rest of the user's indices, on every pixel. Its set of
+// spp samples is then whole: a stratified (Sobol) set loses its error cancellation when a few of
+// its indices come from another estimator (9 of 256 from `tree` in a `power` render doubled the
+// error of cornell-1k's direct light). The other candidates' samples are extra, at the same
+// indices, and weighted against a sample of the chosen one: by their variance relative to it, and
+// by the chosen one's stratification gain (what its whole set's error falls below the error of as
+// many independent samples). The film is split into two halves (a checkerboard of tiles) and the
+// weights in one half come from the other half's measurements only, so they are fixed before the
+// samples they weight. Where stratification pays, an independent sample adds little and weighs
+// little; a candidate far noisier than the rest (power on a city) adds almost nothing.
 #pragma once
 
 #include "render/renderer.h"
@@ -93,18 +100,33 @@ struct PilotResult {
   // variance is too low. Not ranked, and its samples weigh nothing.
   bool missed_tail = false;
   // It rendered its probe only (kProbeParts): it could not be the most efficient. Not ranked;
-  // its samples weigh 1.
+  // its samples weigh as an independent sample of the chosen candidate.
   bool pruned = false;
-  // The weight of each of its exploration samples in the two halves of the film (1: as much as a
-  // sample of a render of one sampler; see the file comment).
+  // The weight of each of its exploration samples in the two halves of the film, against an
+  // independent sample of the chosen candidate (the image divides it by the chosen one's
+  // stratification gain; see the file comment).
   double weight[2] = {0.0, 0.0};
 };
+
+// The chosen candidate's stratification gain over one half of the film: the error of its pixel
+// means as independent samples would make it (their sample variance / spp) over the error its
+// whole set has, at least 1, over the pixels whose camera rays saw an emitter and over the others.
+struct StratificationGain {
+  double emitter = 1.0, other = 1.0;
+};
+// From its samples in two parts of each pixel's set (`a`, `b`: the error of the mean of both is
+// estimated from the difference of the parts' means, as if they were independent, which
+// overstates it where the set's error falls faster than 1 / spp), over the pixels of half `half`
+// (0 or 1) with samples in both; 1 where there are none. `in_view` marks the emitter pixels.
+StratificationGain stratification_gain(const Film& a, const Film& b,
+                                       const std::vector<uint8_t>& in_view, int half);
 
 struct AutoChoice {
   PilotResult chosen;
   std::vector<PilotResult> candidates; // empty: no exploration (see render_auto)
   double pilot_seconds = 0.0;          // the exploration: switches, compiles, renders
-  int explored_samples = 0;            // samples per pixel the exploration rendered
+  int explored_samples = 0;            // the most sample indices per pixel a candidate explored
+  StratificationGain gain[2];          // of the chosen candidate, over each half of the film
   std::string reason;                  // why this candidate, in a few words
 };
 
@@ -194,17 +216,18 @@ constexpr double kCostlyExplorationShare = 0.25;
 bool may_beat(double emitter_variance, double pass_seconds, double best_efficiency);
 
 // Renders samples [settings.first_sample, + settings.spp) of the whole film with the chosen
-// candidate after exploring all, some on bands of rows (exploration_bands(film, explore_period);
-// see the file comment); the film's sums are weighted so that its mean is the
-// unbiased image and its count per pixel is spp. Leaves `renderer` set to the chosen candidate.
-// Where the film's exploration would cost more than kFilmExplorationShare of the samples (always
-// below kFilmExplorationMinSpp spp), down to kInterleavedMinSpp, the candidates explore on
-// interleaved rows; below that kFewSamplesCandidate renders it all, and
-// in a window the last candidate. `probe_cost` multiplies the probe's measured time (tests: a
-// candidate as if that many times costlier).
+// candidate after exploring all on those first indices, some on bands of rows
+// (exploration_bands(film, explore_period); see the file comment); the others' samples are extra,
+// weighted in so that the film's mean is the unbiased image. Its count per pixel is spp. Leaves
+// `renderer` set to the chosen candidate. Where the film's exploration would cost more than
+// kFilmExplorationShare of the samples (always below kFilmExplorationMinSpp spp), down to
+// kInterleavedMinSpp, the candidates explore on interleaved rows; below that kFewSamplesCandidate
+// renders it all, and in a window the last candidate. `probe_cost` multiplies the probe's measured
+// time (tests: a candidate as if that many times costlier). `chosen_samples`, if given, receives
+// the chosen candidate's own samples (tests: they are its render of the user's samples).
 AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
                        const RenderSettings& settings, int explore_period = 0,
-                       double probe_cost = 1.0);
+                       double probe_cost = 1.0, Film* chosen_samples = nullptr);
 
 // One line for logs: "auto: tree (exploration 3 of 16 spp in 0.84 s; efficiency power 12.3 (0.05
 // s/pass, weight 0.1), ...)".
