@@ -486,9 +486,7 @@ int run_render(const RenderArgs& args) {
       auto finite = [](double g) {
         return std::isfinite(g) ? nlohmann::json(g) : nlohmann::json();
       };
-      a["stratification_gain"] = {
-          {"other", {finite(choice->gain[0].other), finite(choice->gain[1].other)}},
-          {"emitter", {finite(choice->gain[0].emitter), finite(choice->gain[1].emitter)}}};
+      a["stratification_gain"] = {finite(choice->gain[0]), finite(choice->gain[1])};
       for (const PilotResult& c : choice->candidates)
         a["candidates"].push_back(
             {{"label", c.label},

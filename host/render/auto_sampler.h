@@ -16,7 +16,9 @@
 // many independent samples). The film is split into two halves (a checkerboard of tiles) and the
 // weights in one half come from the other half's measurements only, so they are fixed before the
 // samples they weight. Where stratification pays, an independent sample adds little and weighs
-// little; a candidate far noisier than the rest (power on a city) adds almost nothing.
+// little; a candidate far noisier than the rest (power on a city) adds almost nothing; near an
+// emitter in view, whose edge the camera positions decide, the others' samples (the chosen one's
+// first positions again) weigh nothing.
 #pragma once
 
 #include "render/renderer.h"
@@ -108,25 +110,21 @@ struct PilotResult {
   double weight[2] = {0.0, 0.0};
 };
 
-// The chosen candidate's stratification gain over one half of the film: the error of its pixel
-// means as independent samples would make it (their sample variance / spp) over the error its
-// whole set has, at least 1, over the pixels whose camera rays saw an emitter and over the others.
-struct StratificationGain {
-  double emitter = 1.0, other = 1.0;
-};
-// From its samples in two parts of each pixel's set (`a`, `b`: the error of the mean of both is
-// estimated from the difference of the parts' means, as if they were independent, which
-// overstates it where the set's error falls faster than 1 / spp), over the pixels of half `half`
-// (0 or 1) with samples in both; 1 where there are none. `in_view` marks the emitter pixels.
-StratificationGain stratification_gain(const Film& a, const Film& b,
-                                       const std::vector<uint8_t>& in_view, int half);
+// The chosen candidate's stratification gain over one half of the film (0 or 1), over the pixels
+// not marked in `near_emitter` with samples in both parts of the set, `a` and `b`: the error of its
+// pixel means as independent samples would make it (their sample variance / spp) over the error
+// its whole set has, estimated from the difference of the parts' means as if they were
+// independent (which overstates it where the set's error falls faster than 1 / spp). At least 1;
+// 1 where no pixel counts.
+double stratification_gain(const Film& a, const Film& b, const std::vector<uint8_t>& near_emitter,
+                           int half);
 
 struct AutoChoice {
   PilotResult chosen;
   std::vector<PilotResult> candidates; // empty: no exploration (see render_auto)
   double pilot_seconds = 0.0;          // the exploration: switches, compiles, renders
   int explored_samples = 0;            // the most sample indices per pixel a candidate explored
-  StratificationGain gain[2];          // of the chosen candidate, over each half of the film
+  double gain[2] = {1.0, 1.0};         // of the chosen candidate, over each half of the film
   std::string reason;                  // why this candidate, in a few words
 };
 
