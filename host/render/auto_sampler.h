@@ -5,20 +5,21 @@
 // `tree` wins where a point's important lights are few, splitting where they are many, `power`
 // where the tree's pick costs more than it buys. The exploration measures which case a scene is.
 //
-// The image stays exactly unbiased, and the chosen candidate's samples stay stratified: every
-// candidate explores the pixel's first sample indices, so the chosen one's exploration is the
-// start of its own set and it renders the rest of the user's indices, on every pixel. Its set of
-// spp samples is then whole: a stratified (Sobol) set loses its error cancellation when a few of
-// its indices come from another estimator (9 of 256 from `tree` in a `power` render doubled the
-// error of cornell-1k's direct light). The other candidates' samples are extra, at the same
-// indices, and weighted against a sample of the chosen one: by their variance relative to it, and
-// by the chosen one's stratification gain (what its whole set's error falls below the error of as
-// many independent samples). The film is split into two halves (a checkerboard of tiles) and the
-// weights in one half come from the other half's measurements only, so they are fixed before the
-// samples they weight. Where stratification pays, an independent sample adds little and weighs
-// little; a candidate far noisier than the rest (power on a city) adds almost nothing; near an
-// emitter in view, whose edge the camera positions decide, the others' samples (the chosen one's
-// first positions again) weigh nothing.
+// The image stays unbiased (but for the choice's film-wide statistics, to which each pixel adds
+// one part in the film's pixel count: docs/design.md), and the chosen candidate's samples stay
+// stratified: every candidate explores the pixel's first sample indices, so the chosen one's
+// exploration is the start of its own set and it renders the rest of the user's indices, on every
+// pixel. Its set of spp samples is then whole: a stratified (Sobol) set loses its error
+// cancellation when a few of its indices come from another estimator (9 of 256 from `tree` in a
+// `power` render cost 1.8x the error on cornell-1k's direct light). The other candidates' samples
+// are extra, at the same indices, and weighted against a sample of the chosen one: by their
+// variance relative to it, and by the chosen one's stratification gain (what its whole set's error
+// falls below the error of as many independent samples). The film is split into two halves (a
+// checkerboard of tiles) and the weights in one half come from the other half's measurements
+// only, so they are fixed before the samples they weight. Where stratification pays, an
+// independent sample adds little and weighs little; a candidate far noisier than the rest (power
+// on a city) adds almost nothing; near an emitter in view, whose edge the camera positions decide,
+// the others' samples (the chosen one's first positions again) weigh nothing.
 #pragma once
 
 #include "render/renderer.h"
