@@ -27,25 +27,6 @@ std::optional<std::string> read_file(const fs::path& p) {
   return ss.str();
 }
 
-// The file named by `#include "file"` on this line, or nothing (another line, or an angle include).
-std::optional<std::string> quoted_include(std::string_view line) {
-  auto skip_blanks = [&] {
-    while (!line.empty() && (line.front() == ' ' || line.front() == '\t'))
-      line.remove_prefix(1);
-  };
-  skip_blanks();
-  if (line.empty() || line.front() != '#') return std::nullopt;
-  line.remove_prefix(1);
-  skip_blanks();
-  if (line.substr(0, 7) != "include") return std::nullopt;
-  line.remove_prefix(7);
-  skip_blanks();
-  if (line.empty() || line.front() != '"') return std::nullopt;
-  const size_t end = line.find('"', 1);
-  if (end == std::string_view::npos) return std::nullopt;
-  return std::string(line.substr(1, end - 1));
-}
-
 // The directive on this line and its first argument ("ifndef", "X" for `#ifndef X`), or "".
 std::pair<std::string_view, std::string_view> directive(std::string_view line) {
   auto word = [&](std::string_view chars) {
@@ -60,6 +41,16 @@ std::pair<std::string_view, std::string_view> directive(std::string_view line) {
   if (word("#") != "#") return {};
   const std::string_view name = word("abcdefghijklmnopqrstuvwxyz");
   return {name, word("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_")};
+}
+
+// The file named by `#include "file"` on this line, or nothing (another line, or an angle include).
+std::optional<std::string> quoted_include(std::string_view line) {
+  if (directive(line).first != "include") return std::nullopt;
+  const size_t open = line.find_first_not_of(" \t", line.find("include") + 7);
+  if (open == std::string_view::npos || line[open] != '"') return std::nullopt;
+  const size_t close = line.find('"', open + 1);
+  if (close == std::string_view::npos) return std::nullopt;
+  return std::string(line.substr(open + 1, close - open - 1));
 }
 
 // Whether the file's first two directives are `#ifndef X` and `#define X` (its include guard).
