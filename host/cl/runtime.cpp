@@ -220,7 +220,7 @@ std::string ClRuntime::device_signature() const {
 }
 
 std::string ClRuntime::build_options(const std::string& options) const {
-  // No "-I": the sources come with their headers expanded (cl/kernel_source.h), so that neither
+  // No "-I": the sources come with their headers expanded (host/cl/kernel_source.h), so neither
   // the options nor the text name this checkout's path.
   std::string opts = fmt::format("-cl-std=CL1.2 -cl-kernel-arg-info {}", options);
   // The tests build kernels with -Werror (a warning in a kernel is a defect like one in the host
