@@ -4,10 +4,9 @@
 #include "cl/kernel_source.h"
 #include "cl/runtime.h"
 #include "render/renderer.h"
+#include "support/test_temp_dir.h"
 
 #include <gtest/gtest.h>
-
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -21,10 +20,8 @@ namespace {
 class KernelSourceTest : public ::testing::Test {
 protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("canopy-test-source-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
+    dir_ = test::test_temp_dir("source");
+    fs::remove_all(dir_); // a fresh tree: what a failed run left would change the expansion
     fs::create_directories(dir_ / "sub");
   }
   void TearDown() override { fs::remove_all(dir_); }
