@@ -10,7 +10,8 @@ stage time, for each build, and the render wall time.
                            --build new=build/canopy:cl --runs 5 [--scenes default,city] [--spp 4]
 
 A build is NAME=CANOPY_BINARY:KERNEL_DIR (the kernel sources it was built with, passed as
-CANOPY_KERNEL_DIR). Scenes render at their own sampler, depth and resolution, 4 spp by default.
+CANOPY_KERNEL_DIR). Scenes render at their own sampler (`auto` on the shipped scenes), depth and
+resolution, 4 spp by default; `--light-sampler S` renders every scene with S instead.
 """
 
 import argparse
@@ -25,11 +26,13 @@ SCENES = ["default", "glossy-cornell", "showroom", "cornell-1k", "cornell-1m", "
           "spiral-10k", "city", "mesh-light", "spiral-fog", "city-fog"]
 
 
-def run_once(binary, kernels, scene, spp, out_dir):
+def run_once(binary, kernels, scene, spp, out_dir, sampler=None):
     stats = os.path.join(out_dir, "stats.json")
     env = dict(os.environ, CANOPY_KERNEL_DIR=kernels)
     cmd = [binary, "render", scene, "--spp", str(spp), "--stats-json", stats,
            "--out", os.path.join(out_dir, "image.exr")]
+    if sampler:
+        cmd += ["--light-sampler", sampler]
     r = subprocess.run(cmd, env=env, capture_output=True, text=True)
     if r.returncode != 0:
         sys.exit(f"stage-table: {' '.join(cmd)} failed:\n{r.stderr}")
@@ -43,6 +46,7 @@ def main():
                     help="NAME=CANOPY_BINARY:KERNEL_DIR (repeat for each build)")
     ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--spp", type=int, default=4)
+    ap.add_argument("--light-sampler", help="render every scene with this light sampler")
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--scene-dir", default=os.path.join(os.path.dirname(__file__), "..", "scenes"))
     a = ap.parse_args()
@@ -62,7 +66,7 @@ def main():
             runs = {name: [] for name, _, _ in builds}
             for _ in range(a.runs):
                 for name, binary, kernels in builds:
-                    runs[name].append(run_once(binary, kernels, path, a.spp, tmp))
+                    runs[name].append(run_once(binary, kernels, path, a.spp, tmp, a.light_sampler))
             first = runs[builds[0][0]][0]
             print(f"### {scene} ({first['lights']} lights, {first['light_sampler']}, "
                   f"{a.spp} spp)\n")
