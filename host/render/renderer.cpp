@@ -77,20 +77,20 @@ float resolve_channel(double sum, double n, bool* beyond) {
 // A render of bands of the window's rows, its rows packed, spread over the window's `rows` rows;
 // the rows it did not cover have no samples.
 Film spread_rows(Film packed, const RowBands& bands, int rows) {
-  Film film = packed;
+  const std::vector<double4> sum = std::move(packed.sum), sumsq = std::move(packed.sumsq),
+                             counts = std::move(packed.counts);
+  Film film = std::move(packed); // its dimensions; the sums are spread below
   film.height = rows;
-  const size_t n = size_t(film.width) * size_t(rows);
+  const size_t width = size_t(film.width), n = width * size_t(rows);
   film.sum.assign(n, double4{});
   film.sumsq.assign(n, double4{});
   film.counts.assign(n, double4{});
-  for (int r = 0; r < packed.height; ++r) {
-    const size_t from = size_t(r) * size_t(film.width);
-    const size_t to = size_t(covered_row(bands.packed(), uint(r))) * size_t(film.width);
-    for (size_t x = 0; x < size_t(film.width); ++x) {
-      film.sum[to + x] = packed.sum[from + x];
-      film.sumsq[to + x] = packed.sumsq[from + x];
-      film.counts[to + x] = packed.counts[from + x];
-    }
+  for (size_t r = 0, from = 0; from < sum.size(); ++r, from += width) {
+    const auto to = std::ptrdiff_t(size_t(covered_row(bands.packed(), uint(r))) * width);
+    const auto f = std::ptrdiff_t(from), w = std::ptrdiff_t(width);
+    std::copy(sum.begin() + f, sum.begin() + f + w, film.sum.begin() + to);
+    std::copy(sumsq.begin() + f, sumsq.begin() + f + w, film.sumsq.begin() + to);
+    std::copy(counts.begin() + f, counts.begin() + f + w, film.counts.begin() + to);
   }
   return film;
 }
@@ -579,12 +579,12 @@ Film Renderer::render(const RenderSettings& settings) {
   q.enqueueReadBuffer(film_sumsq, CL_TRUE, 0, size_t(npix) * sizeof(double4), film.sumsq.data());
   // Undo the device's emission scale 2^-k: exact in double (a power of two; the sums of float
   // samples times 2^k, |k| <= 149 + 128, stay far inside double's range).
-  const int k = stats_.emission_exponent;
+  const double scale = std::ldexp(1.0, stats_.emission_exponent), scale2 = scale * scale;
   for (size_t p = 0; p < size_t(npix); ++p) {
     double4& s = film.sum[p];
     double4& q2 = film.sumsq[p];
-    s.x = std::ldexp(s.x, k), s.y = std::ldexp(s.y, k), s.z = std::ldexp(s.z, k);
-    q2.x = std::ldexp(q2.x, 2 * k), q2.y = std::ldexp(q2.y, 2 * k), q2.z = std::ldexp(q2.z, 2 * k);
+    s.x *= scale, s.y *= scale, s.z *= scale;
+    q2.x *= scale2, q2.y *= scale2, q2.z *= scale2;
   }
   if (!bands.all()) film = spread_rows(std::move(film), bands, win.height());
   stats_.overflowed_pixels += film.overflowed_pixels();
