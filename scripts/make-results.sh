@@ -13,14 +13,14 @@
 #   EQUAL_TIME=0.2 REF_TIME=4 SEEDS=3 ALLOW_FEW_SEEDS=1 DOCS=/tmp/r REPORT=/tmp/r.md WORK=/tmp/r/work \
 #     SCENES="plane-10k default" ./scripts/make-results.sh
 #
-# Environment: SCENES; BUILD, CANOPY, SKIP_BUILD; EQUAL_TIME (seconds per render) and REF_TIME
-# (reference seconds) override the table's; SEEDS (8: fewer is refused unless ALLOW_FEW_SEEDS=1);
-# PROCESS_RUNS (whole-process runs per configuration, 3); SAMPLERS (the configurations
-# compared); DEPTHS ("full 1": the scene's depth, then direct light); WORK (out/results:
-# references and logs), DOCS (docs/results: CSVs, small PNGs) and REPORT (docs/results.md) move
-# the outputs; REUSE_REFERENCE=1 keeps a reference already in $WORK (with
-# its REF.mask.png; converge refuses one of another depth or film size, the sampler is the
-# caller's responsibility) instead of rendering it again.
+# Environment: SCENES; BUILD, CANOPY, SKIP_BUILD; EQUAL_TIME (seconds per render), REF_TIME
+# (reference seconds) and REF_SAMPLER (the reference's configuration) override the table's; SEEDS
+# (8: fewer is refused unless ALLOW_FEW_SEEDS=1); PROCESS_RUNS (whole-process runs per
+# configuration, 3); SAMPLERS (the configurations compared); DEPTHS ("full 1": the scene's depth,
+# then direct light); WORK (out/results: references and logs), DOCS (docs/results: CSVs, small PNGs)
+# and REPORT (docs/results.md) move the outputs; REUSE_REFERENCE=1 keeps a reference already in
+# $WORK (with its REF.mask.png; converge refuses one of another depth or film size, the sampler is
+# the caller's responsibility) instead of rendering it again.
 #
 # Method. Per configuration, `canopy converge --equal-time T` builds and warms up the renderer
 # (kernel builds are not timed), chooses the spp for which one render takes about T seconds from
@@ -110,6 +110,7 @@ for name in $SCENES; do
   IFS='|' read -r _ scale eqt ref_sampler ref_time clamp <<<"$(echo "$row" | tr -d ' ')"
   eqt=${EQUAL_TIME:-$eqt}
   ref_time=${REF_TIME:-$ref_time}
+  ref_sampler=${REF_SAMPLER:-$ref_sampler}
   scene=scenes/$name.json
   if [ ! -f "$scene" ]; then
     echo "make-results: $scene does not exist, skipped" >&2
@@ -179,6 +180,7 @@ done
 note="Last run ($(date -u '+%Y-%m-%d %H:%M') UTC): \`SCENES=\"$SCENES\"\`, $SEEDS seeds per point"
 if [ -n "${EQUAL_TIME:-}" ]; then note+=", equal time $EQUAL_TIME s per render"; fi
 if [ -n "${REF_TIME:-}" ]; then note+=", references of $REF_TIME s"; fi
+if [ -n "${REF_SAMPLER:-}" ]; then note+=" rendered with $REF_SAMPLER"; fi
 note+=". Scenes not in SCENES come from the CSVs of an earlier run."
 python3 scripts/results-report.py --docs "$DOCS" --command "./scripts/make-results.sh" \
   --note "$note" >"$REPORT.tmp"
