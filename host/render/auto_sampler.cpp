@@ -90,14 +90,25 @@ void add_samples(Film& a, const Film& b, const std::vector<double>* w = nullptr,
   }
 }
 
-int tile_of(const Film& f, size_t p) {
-  const int x = int(p % size_t(f.width)), y = int(p / size_t(f.width));
-  return (y * kTiles / f.height) * kTiles + x * kTiles / f.width;
+// The tile of each of the film's pixels, row-major (kTiles x kTiles tiles: a division per row and
+// column rather than per pixel, which the statistics below, run between renders, would pay
+// several times per film).
+std::vector<uint8_t> pixel_tiles(const Film& f) {
+  static_assert(kTiles * kTiles <= 256, "a tile index fits a byte");
+  std::vector<uint8_t> tiles(f.sum.size());
+  std::vector<int> column(size_t(std::max(f.width, 0)));
+  for (int x = 0; x < f.width; ++x)
+    column[size_t(x)] = x * kTiles / f.width;
+  for (size_t p = 0, y = 0; p < tiles.size(); ++y) {
+    const int row = int(y) * kTiles / f.height * kTiles;
+    for (int x = 0; x < f.width; ++x, ++p)
+      tiles[p] = uint8_t(row + column[size_t(x)]);
+  }
+  return tiles;
 }
 
-// The half (0 or 1) of the film's checkerboard of tiles that pixel p is in.
-int half_of(const Film& f, size_t p) {
-  const int t = tile_of(f, p);
+// The half (0 or 1) of the film's checkerboard of tiles that tile t is in.
+int half_of_tile(int t) {
   return (t / kTiles + t % kTiles) & 1;
 }
 
@@ -121,9 +132,10 @@ double pixel_variance(const Film& film, size_t p) {
 double stratification_gain(const Film& a, const Film& b, const std::vector<uint8_t>& near_emitter,
                            int half) {
   double independent = 0.0, whole = 0.0;
+  const std::vector<uint8_t> tile_index = pixel_tiles(a);
   for (size_t p = 0; p < a.sum.size(); ++p) {
     const double na = a.sum[p].w, nb = b.sum[p].w;
-    if (near_emitter[p] || half_of(a, p) != half || na <= 0.0 || nb <= 0.0) continue;
+    if (near_emitter[p] || half_of_tile(tile_index[p]) != half || na <= 0.0 || nb <= 0.0) continue;
     const double n = na + nb;
     const double sa[3] = {a.sum[p].x, a.sum[p].y, a.sum[p].z};
     const double sb[3] = {b.sum[p].x, b.sum[p].y, b.sum[p].z};
@@ -174,8 +186,9 @@ EmitterPool pool_emitters(const std::vector<Film>& films, const std::vector<uint
   pool.pixels.assign(tiles, 0.0);
   std::vector<double> n(tiles, 0.0);
   if (films.empty()) return pool;
+  const std::vector<uint8_t> tile_index = pixel_tiles(films[0]);
   for (size_t p = 0; p < films[0].sum.size(); ++p) {
-    const size_t t = size_t(tile_of(films[0], p));
+    const size_t t = tile_index[p];
     bool explored = false;
     for (const Film& f : films) {
       if (!(f.sum[p].w > 1.0)) continue;
@@ -214,16 +227,19 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
         rank[y] = int(r++);
         break;
       }
+  const std::vector<uint8_t> tile_index = pixel_tiles(film);
+  auto in_half = [&](size_t p) { return half < 0 || half_of_tile(tile_index[p]) == half; };
   bool any_clear = false;
-  for (size_t p = 0; p < film.sum.size(); ++p)
-    any_clear =
-        any_clear || ((half < 0 || half_of(film, p) == half) && !emitter[p] && film.sum[p].w > 1.0);
-  for (size_t p = 0; p < film.sum.size(); ++p) {
-    if (half >= 0 && half_of(film, p) != half) continue;
+  for (size_t p = 0; p < film.sum.size() && !any_clear; ++p)
+    any_clear = in_half(p) && !emitter[p] && film.sum[p].w > 1.0;
+  v.reserve(film.sum.size());
+  for (size_t p = 0, row = 0, row_end = width; p < film.sum.size(); ++p) {
+    if (p == row_end) ++row, row_end += width;
+    if (!in_half(p)) continue;
     const double k = film.sum[p].w;
     if (!(k > 1.0)) continue;
     const double s[3] = {film.sum[p].x, film.sum[p].y, film.sum[p].z};
-    const int t = tile_of(film, p);
+    const int t = tile_index[p];
     double vp = pixel_variance(film, p);
     if (in_view && pool && (*in_view)[p] && std::isfinite(pool->variance[size_t(t)])) {
       vp = pool->variance[size_t(t)];
@@ -238,7 +254,7 @@ ExploreStats explore_stats(const Film& film, const std::vector<uint8_t>& emitter
     mean += value;
     mean_var += vp / k;
     ++clear;
-    const int side = rank[p / width] & 1;
+    const int side = rank[row] & 1;
     split_sum[side] += value, split_var[side] += vp / k, split_n[side] += 1.0;
   }
   ExploreStats st;
@@ -500,12 +516,13 @@ std::vector<RowBands> probe_parts(const RowBands& b, int rows) {
   return parts;
 }
 
-// The candidates' measurements from their exploration films, over the film and over each half.
+// The candidates' measurements from their exploration films, over the film and, with `halves`,
+// over each half (the weights need them; the costly candidate's probe decisions do not).
 struct Measured {
   std::vector<ExploreStats> film, half[2];
 };
 
-Measured measure(const std::vector<Film>& films, double emitter_scale) {
+Measured measure(const std::vector<Film>& films, double emitter_scale, bool halves) {
   Measured m;
   if (films.empty()) return m;
   // The image means compare over the same pixels: those no candidate's camera rays saw an emitter
@@ -536,7 +553,7 @@ Measured measure(const std::vector<Film>& films, double emitter_scale) {
   for (const Film& f : films) {
     m.film.push_back(explore_stats(f, off_mean, -1, &emitter, &pool));
     m.film.back().own_rows = !any_common;
-    for (int h = 0; h < 2; ++h) {
+    for (int h = 0; h < (halves ? 2 : 0); ++h) {
       m.half[h].push_back(explore_stats(f, off_mean, h, &emitter, &pool));
       m.half[h].back().own_rows = !any_common;
     }
@@ -673,7 +690,7 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     PilotResult& c = cand[i];
     // The last, costly candidate against the most efficient explored before it.
     const bool costly_candidate = i + 1 == cand.size() && i > 0;
-    const Measured before = costly_candidate ? measure(films, emitter_scale) : Measured{};
+    const Measured before = costly_candidate ? measure(films, emitter_scale, false) : Measured{};
     const size_t b = costly_candidate ? best_explored(cand, i, before) : i;
     const double tree_pass = tree_pass_seconds(cand, i);
     if (costly_candidate && tree_pass > 0.0 &&
@@ -735,7 +752,8 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
         probed = 2;
         std::vector<Film> with = films;
         with.push_back(film);
-        const int verdict = against_best(cand, i, measure(with, emitter_scale), probe_cost * pass);
+        const int verdict =
+            against_best(cand, i, measure(with, emitter_scale, false), probe_cost * pass);
         keep = costly ? verdict > 0 : verdict >= 0;
       } else if (keep) {
         keep = !costly; // one sample per pixel: no variance to weigh against the cost
@@ -789,7 +807,7 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     choice.explored_samples = std::max(choice.explored_samples, c.samples);
 
   // Measurements over the film and over each half.
-  const Measured m = measure(films, emitter_scale);
+  const Measured m = measure(films, emitter_scale, true);
   std::vector<ExploreStats> halves[2];
   for (size_t i = 0; i < cand.size(); ++i) {
     cand[i].stats = m.film[i];
@@ -852,9 +870,10 @@ AutoRender render_auto(Renderer& renderer, const RendererOptions& base,
     choice.gain[h] = stratification_gain(part[0], part[1], near, h);
   std::vector<std::vector<double>> wc(cand.size(), std::vector<double>(npixels, 0.0));
   std::vector<double> scale(npixels, 1.0);
+  const std::vector<uint8_t> tile_index = pixel_tiles(part[0]);
   for (size_t p = 0; p < npixels; ++p) {
     if (near[p]) continue;
-    const int h = half_of(part[0], p);
+    const int h = half_of_tile(tile_index[p]);
     double extra = 0.0; // the other candidates' samples at p, in samples of the chosen one
     for (size_t i = 0; i < cand.size(); ++i) {
       if (i == best) continue;
